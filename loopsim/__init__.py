@@ -1,0 +1,13 @@
+"""loopsim: flexible elastic loops sedimenting in a viscous (Stokes) fluid.
+
+Layout: ``spectral`` (Fourier algebra), ``physics`` (the three maps and the
+tension solve, njit), ``problems`` and ``integrate`` (time stepping, njit),
+``initial`` and ``diagnostics`` (shapes), ``linear_stability`` (paper's
+operator), ``api`` (Python entry points), ``io`` (Parquet), ``cli``.
+"""
+__version__ = "0.1.0"
+
+from .api import SUMMARY_FIELDS, SimulationResult, evaluate_maps, simulate, stability_parameter
+
+__all__ = ["simulate", "SimulationResult", "evaluate_maps", "stability_parameter",
+           "SUMMARY_FIELDS", "__version__"]

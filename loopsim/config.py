@@ -1,0 +1,32 @@
+"""JIT options and numerical defaults, kept in one place.
+
+Conventions used throughout loopsim (stated once, tested in ``tests/``):
+
+* Lengths are scaled by L / 2π, so the loop has length 2π and arc length
+  s ∈ [0, 2π).  Forces are scaled by 8π³EI / L³ (per unit length, per L³),
+  time so that the dimensionless equations read (paper §3)::
+
+      f = -x'''' + (T x')' - g0 e_z
+      u = f + (x'·f) x'
+      0 = x'·u' - w (1 - x'·x')
+
+* Gravity points along -z.  Angles are radians inside the package and
+  degrees at the user interface (CLI flags, result tables).
+* The tension reported to users is the physical axial force
+  N = T + |x''|², not the Lagrange multiplier T (see ``diagnostics``).
+"""
+
+# No fastmath: results must be bit-reproducible across thread counts.
+JIT = dict(cache=True, nogil=True, error_model="numpy")
+
+#: Default penalty rate of the length-creation term (see README "Choice of w").
+DEFAULT_W = 10.0
+DEFAULT_N = 6
+DEFAULT_T_END = 10.0
+DEFAULT_RTOL = 1e-6
+DEFAULT_ATOL = 1e-9
+DEFAULT_PERTURBATION = 1e-3
+DEFAULT_SEED = 0
+DEFAULT_MAX_STEPS = 2_000_000
+#: Relative length error beyond which a run stops with status LENGTH_ERROR.
+DEFAULT_LENGTH_TOL = 1e-3

@@ -1,0 +1,233 @@
+"""Adaptive time integration in Numba: tableau, one step, controller, driver.
+
+A method is data (its tableau) plus one function that attempts a step.  The
+driver :func:`integrate` owns everything else: error control with scipy's
+meaning of ``rtol``/``atol``, accept/reject, step-size bounds, the step
+budget, output at requested times and the status code.  It never raises:
+failures come back as a status (see ``STATUS_NAMES``).
+
+The right-hand side comes from ``problems.rhs(problem, y, dydt)``, which is
+specialised on the problem's type at compile time, so the same compiled
+driver code serves the loop and the closed-form test problems.
+
+Adding a scheme: give it a method id in ``METHODS``, a step function with the
+signature of :func:`rkf45_attempt` and a branch in :func:`_attempt`; every
+test parametrised over ``METHODS`` then covers it.
+"""
+import numba
+import numpy as np
+
+from .config import JIT
+from .problems import constraint_error, rhs
+
+# ---- status codes --------------------------------------------------------
+OK = 0
+STEP_BUDGET = 1
+STEP_UNDERFLOW = 2
+NON_FINITE = 3
+LENGTH_ERROR = 4
+STATUS_NAMES = {
+    OK: "ok",
+    STEP_BUDGET: "step budget exhausted",
+    STEP_UNDERFLOW: "step size underflow",
+    NON_FINITE: "non-finite state",
+    LENGTH_ERROR: "length error too large",
+}
+
+# ---- methods ---------------------------------------------------------------
+RKF45 = 0
+METHODS = {"rkf45": RKF45}
+
+# Runge–Kutta–Fehlberg 4(5): E. Fehlberg, NASA TR R-315 (1969), Table III.
+# We advance with the 5th-order weights (local extrapolation) and use the
+# difference to the embedded 4th-order weights as the error estimate.
+RKF45_C = np.array([0.0, 1 / 4, 3 / 8, 12 / 13, 1.0, 1 / 2])
+RKF45_A = np.array(
+    [
+        [0.0, 0.0, 0.0, 0.0, 0.0],
+        [1 / 4, 0.0, 0.0, 0.0, 0.0],
+        [3 / 32, 9 / 32, 0.0, 0.0, 0.0],
+        [1932 / 2197, -7200 / 2197, 7296 / 2197, 0.0, 0.0],
+        [439 / 216, -8.0, 3680 / 513, -845 / 4104, 0.0],
+        [-8 / 27, 2.0, -3544 / 2565, 1859 / 4104, -11 / 40],
+    ]
+)
+RKF45_B5 = np.array([16 / 135, 0.0, 6656 / 12825, 28561 / 56430, -9 / 50, 2 / 55])
+RKF45_B4 = np.array([25 / 216, 0.0, 1408 / 2565, 2197 / 4104, -1 / 5, 0.0])
+RKF45_E = RKF45_B5 - RKF45_B4
+RKF45_ERROR_ORDER = 4  # the embedded estimate is O(h^5): factor err^(-1/5)
+RKF45_STAGES = 6
+
+# ---- step-size controller (same constants as scipy.integrate.RK45) --------
+SAFETY = 0.9
+MIN_FACTOR = 0.2
+MAX_FACTOR = 10.0
+
+
+@numba.njit(**JIT)
+def rms_error_norm(err, y, y_new, rtol, atol):
+    """sqrt(mean((err / (atol + rtol max(|y|, |y_new|)))²)), as scipy."""
+    acc = 0.0
+    for i in range(y.shape[0]):
+        scale = atol + rtol * max(abs(y[i]), abs(y_new[i]))
+        acc += (err[i] / scale) ** 2
+    return np.sqrt(acc / y.shape[0])
+
+
+@numba.njit(**JIT)
+def step_factor(err_norm, error_order):
+    """Step-size factor SAFETY err^(-1/(p+1)), clipped to [MIN_FACTOR, MAX_FACTOR]."""
+    if err_norm == 0.0:
+        return MAX_FACTOR
+    if not np.isfinite(err_norm):
+        return MIN_FACTOR
+    return min(MAX_FACTOR, max(MIN_FACTOR, SAFETY * err_norm ** (-1.0 / (error_order + 1))))
+
+
+@numba.njit(**JIT)
+def rkf45_attempt(problem, y, h, k, stage, y_new, err):
+    """One Fehlberg step from y with step h: y_new (5th order) and err = y5 - y4.
+
+    k[0] must hold f(y) on entry; k[1..5] and ``stage`` are overwritten.
+    Returns the number of right-hand-side evaluations made (5).
+    """
+    ny = y.shape[0]
+    for s in range(1, RKF45_STAGES):
+        for i in range(ny):
+            acc = 0.0
+            for j in range(s):
+                acc += RKF45_A[s, j] * k[j, i]
+            stage[i] = y[i] + h * acc
+        rhs(problem, stage, k[s])
+    for i in range(ny):
+        acc5 = 0.0
+        acce = 0.0
+        for j in range(RKF45_STAGES):
+            acc5 += RKF45_B5[j] * k[j, i]
+            acce += RKF45_E[j] * k[j, i]
+        y_new[i] = y[i] + h * acc5
+        err[i] = h * acce
+    return RKF45_STAGES - 1
+
+
+@numba.njit(**JIT)
+def _attempt(method, problem, y, h, k, stage, y_new, err):
+    """Dispatch one step attempt to the chosen method."""
+    return rkf45_attempt(problem, y, h, k, stage, y_new, err)
+
+
+@numba.njit(**JIT)
+def _error_order(method):
+    return RKF45_ERROR_ORDER
+
+
+@numba.njit(**JIT)
+def _all_finite(a):
+    for v in a.flat:
+        if not np.isfinite(v):
+            return False
+    return True
+
+
+@numba.njit(**JIT)
+def initial_step(problem, y0, f0, rtol, atol, error_order, h_max):
+    """Starting step by the Hairer–Nørsett–Wanner heuristic (as scipy's)."""
+    ny = y0.shape[0]
+    d0 = 0.0
+    d1 = 0.0
+    for i in range(ny):
+        scale = atol + rtol * abs(y0[i])
+        d0 += (y0[i] / scale) ** 2
+        d1 += (f0[i] / scale) ** 2
+    d0 = np.sqrt(d0 / ny)
+    d1 = np.sqrt(d1 / ny)
+    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
+    y1 = y0 + h0 * f0
+    f1 = np.empty(ny)
+    rhs(problem, y1, f1)
+    d2 = 0.0
+    for i in range(ny):
+        scale = atol + rtol * abs(y0[i])
+        d2 += ((f1[i] - f0[i]) / scale) ** 2
+    d2 = np.sqrt(d2 / ny) / h0
+    if d1 <= 1e-15 and d2 <= 1e-15:
+        h1 = max(1e-6, h0 * 1e-3)
+    else:
+        h1 = (0.01 / max(d1, d2)) ** (1.0 / (error_order + 1))
+    return min(100.0 * h0, h1, h_max)
+
+
+@numba.njit(**JIT)
+def integrate(method, problem, y0, t0, t_end, t_out, rtol, atol, h_init, h_min,
+              h_max, max_steps, constraint_tol, y_out):
+    """Integrate dy/dt = rhs(problem, y) from t0 to t_end.
+
+    t_out: sorted output times in [t0, t_end]; the state at t_out[i] is written
+    to y_out[i] (steps are shortened to land on them exactly).  Rows of
+    y_out for times not reached are left untouched.
+    h_init <= 0 selects the starting step automatically.
+    constraint_tol: stop with LENGTH_ERROR once |constraint_error| exceeds it.
+
+    Returns (status, t, y, steps_accepted, steps_rejected, rhs_evals).
+    """
+    ny = y0.shape[0]
+    y = y0.copy()
+    y_new = np.empty(ny)
+    err = np.empty(ny)
+    stage = np.empty(ny)
+    k = np.empty((RKF45_STAGES, ny))
+    order = _error_order(method)
+    n_acc = 0
+    n_rej = 0
+    n_rhs = 1
+    t = t0
+    rhs(problem, y, k[0])
+    if not _all_finite(k[0]) or not _all_finite(y):
+        return NON_FINITE, t, y, n_acc, n_rej, n_rhs
+    i_out = 0
+    while i_out < t_out.shape[0] and t_out[i_out] <= t0:
+        y_out[i_out] = y
+        i_out += 1
+    if h_init > 0.0:
+        h = min(h_init, h_max)
+    else:
+        h = initial_step(problem, y, k[0], rtol, atol, order, h_max)
+        n_rhs += 1
+    while t < t_end:
+        if n_acc + n_rej >= max_steps:
+            return STEP_BUDGET, t, y, n_acc, n_rej, n_rhs
+        floor = max(h_min, 10.0 * np.finfo(np.float64).eps * abs(t))
+        if h < floor:
+            status = STEP_UNDERFLOW if _all_finite(y) else NON_FINITE
+            return status, t, y, n_acc, n_rej, n_rhs
+        # land exactly on the next output time or on t_end
+        t_stop = t_end
+        if i_out < t_out.shape[0] and t_out[i_out] < t_stop:
+            t_stop = t_out[i_out]
+        h_try = h
+        # stretch by up to 1e-8 relative rather than leave a sliver of a step
+        clipped = t + h_try * (1.0 + 1e-8) >= t_stop
+        if clipped:
+            h_try = t_stop - t
+        n_rhs += _attempt(method, problem, y, h_try, k, stage, y_new, err)
+        err_norm = rms_error_norm(err, y, y_new, rtol, atol)
+        if not (err_norm <= 1.0):  # also rejects NaN
+            n_rej += 1
+            h = h_try * step_factor(err_norm, order)
+            continue
+        n_acc += 1
+        t = t_stop if clipped else t + h_try
+        y[:] = y_new
+        rhs(problem, y, k[0])
+        n_rhs += 1
+        if not _all_finite(k[0]):
+            return NON_FINITE, t, y, n_acc, n_rej, n_rhs
+        if abs(constraint_error(problem, y)) > constraint_tol:
+            return LENGTH_ERROR, t, y, n_acc, n_rej, n_rhs
+        while i_out < t_out.shape[0] and t_out[i_out] <= t:
+            y_out[i_out] = y
+            i_out += 1
+        # a step shortened to hit an output time says nothing about the next h
+        factor = step_factor(err_norm, order)
+        h = min(h_max, max(h, h_try * factor) if clipped else h_try * factor)
+    return OK, t, y, n_acc, n_rej, n_rhs

@@ -1,0 +1,204 @@
+"""The loop's equations of motion as three affine maps (paper §5), in Numba.
+
+    T --(1) Euler–Bernoulli--> f --(2) local SBT--> u --(3) inextensibility--> ε
+
+    (1) f = P_n[ -x'''' + (T x')' - g0 e_z ]
+    (2) u = P_n[ f + (x'·f) x' ]
+    (3) ε = x'·u' - w (1 - x'·x')            (order 2n, not truncated)
+
+x, f, u and T are series of order n (``spectral`` layout); P_n is the
+projection onto order n.  The maps are affine in T, so for a given shape we
+evaluate them once on each of the 2n + 1 tension basis functions φ_j (the
+linear part) and once with T = 0 (the affine part), as the columns of one
+block: column j < K carries T = φ_j, column K carries T = 0 with gravity,
+bending and the penalty.  The tension is then the real least-squares
+solution of  min_T ||ε(T)||²_{L²}.
+
+All products are formed on the grid of M = 4n + 1 points: it resolves ε
+(order 2n) exactly, so the grid sum of ε² is its exact L² norm (up to the
+factor 2π / M), and the projections of f (order 2n) and of (x'·f) x'
+(order 3n) onto order n are alias-free there.
+"""
+import collections
+
+import numba
+import numpy as np
+
+from . import spectral
+from .config import JIT
+
+#: Precomputed constant matrices of one truncation order, shared by all cases.
+#: S0, S1, S2, S4: (M, K) synthesis of the value and 1st/2nd/4th derivative;
+#: F: (K, M) projection onto order n; P = S0 F and P1 = S1 F: (M, M)
+#: grid-to-grid projection and projected derivative.
+LoopOperators = collections.namedtuple("LoopOperators", "n m S0 S1 S2 S4 F P P1")
+
+#: Per-case scratch arrays, so the right-hand side never allocates.
+Workspace = collections.namedtuple(
+    "Workspace", "tangent curvature x4 force mobile length_rate velocity tension"
+)
+
+
+def grid_size(n):
+    """Collocation points used by the maps: M = 4n + 1."""
+    return 4 * n + 1
+
+
+def make_operators(n):
+    """Build the constant matrices for truncation order n."""
+    m = grid_size(n)
+    S = [np.ascontiguousarray(spectral.synthesis_matrix(n, m, d)) for d in (0, 1, 2, 4)]
+    F = np.ascontiguousarray(spectral.analysis_matrix(n, m))
+    return LoopOperators(
+        n, m, S[0], S[1], S[2], S[3], F,
+        np.ascontiguousarray(S[0] @ F), np.ascontiguousarray(S[1] @ F),
+    )
+
+
+@numba.njit(**JIT)
+def make_workspace(n):
+    m = 4 * n + 1
+    k = 2 * n + 1
+    return Workspace(
+        np.empty((3, m)), np.empty((3, m)), np.empty((3, m)),
+        np.empty((3, m, k + 1)), np.empty((3, m, k + 1)), np.empty((m, k + 1)),
+        np.empty((3, m)), np.empty(k),
+    )
+
+
+@numba.njit(**JIT)
+def shape_on_grid(x, ops, ws):
+    """Grid values of x', x'' and x'''' from coefficients x (3, K)."""
+    ws.tangent[:] = np.dot(x, ops.S1.T)
+    ws.curvature[:] = np.dot(x, ops.S2.T)
+    ws.x4[:] = np.dot(x, ops.S4.T)
+
+
+@numba.njit(**JIT)
+def force_map(g0, ops, ws):
+    """Map (1): f = P_n[(T x')' - x'''' - g0 e_z], as a block of columns.
+
+    (T x')' = T' x' + T x''; column j < K uses T = φ_j (no gravity, no
+    bending: the linear part), column K uses T = 0 (the affine part).
+    """
+    m, k = ops.m, ops.S0.shape[1]
+    raw = np.empty((m, k + 1))
+    for c in range(3):
+        t, kap = ws.tangent[c], ws.curvature[c]
+        for i in range(m):
+            for j in range(k):
+                raw[i, j] = t[i] * ops.S1[i, j] + kap[i] * ops.S0[i, j]
+            raw[i, k] = -ws.x4[c, i] - (g0 if c == 2 else 0.0)
+        ws.force[c] = np.dot(ops.P, raw)
+
+
+@numba.njit(**JIT)
+def velocity_map(ws):
+    """Map (2) before projection: u = f + (x'·f) x'  (stored in ws.mobile)."""
+    t, f = ws.tangent, ws.force
+    m, cols = f.shape[1], f.shape[2]
+    for i in range(m):
+        for j in range(cols):
+            h = t[0, i] * f[0, i, j] + t[1, i] * f[1, i, j] + t[2, i] * f[2, i, j]
+            for c in range(3):
+                ws.mobile[c, i, j] = f[c, i, j] + h * t[c, i]
+
+
+@numba.njit(**JIT)
+def length_creation_map(w, ops, ws):
+    """Map (3): ε = x'·(P_n u)' - w (1 - x'·x'), as a block of columns."""
+    t = ws.tangent
+    ws.length_rate[:] = 0.0
+    for c in range(3):
+        du = np.dot(ops.P1, ws.mobile[c])
+        for i in range(ops.m):
+            ws.length_rate[i, :] += t[c, i] * du[i, :]
+    k = ops.S0.shape[1]
+    for i in range(ops.m):
+        stretch = t[0, i] ** 2 + t[1, i] ** 2 + t[2, i] ** 2
+        ws.length_rate[i, k] -= w * (1.0 - stretch)
+
+
+@numba.njit(**JIT)
+def least_squares_affine(a, out):
+    """Solve min_τ ||A τ + b||₂ for the augmented block a = [A | b] (destroyed).
+
+    Householder QR of A (columns 0..K-1) applied to b as well, then back
+    substitution R τ = -(Qᵀ b)[:K].  A must have full column rank.
+    """
+    m, cols = a.shape
+    k = cols - 1
+    for j in range(k):
+        norm = 0.0
+        for i in range(j, m):
+            norm += a[i, j] * a[i, j]
+        norm = np.sqrt(norm)
+        alpha = -norm if a[j, j] >= 0.0 else norm
+        # v = a[j:, j] - alpha e_1, stored in place; H = I - 2 v vᵀ / vᵀv
+        a[j, j] -= alpha
+        vtv = 0.0
+        for i in range(j, m):
+            vtv += a[i, j] * a[i, j]
+        if vtv > 0.0:
+            for jj in range(j + 1, cols):
+                dot = 0.0
+                for i in range(j, m):
+                    dot += a[i, j] * a[i, jj]
+                scale = 2.0 * dot / vtv
+                for i in range(j, m):
+                    a[i, jj] -= scale * a[i, j]
+        a[j, j] = alpha
+    for j in range(k - 1, -1, -1):
+        acc = -a[j, k]
+        for jj in range(j + 1, k):
+            acc -= a[j, jj] * out[jj]
+        out[j] = acc / a[j, j]
+
+
+@numba.njit(**JIT)
+def loop_velocity(x, g0, w, ops, ws, u_out):
+    """Velocity coefficients u (3, K) of the shape x (3, K); tension left in ws.tension.
+
+    The least-squares solve destroys ws.length_rate; the residual is not kept.
+    """
+    shape_on_grid(x, ops, ws)
+    force_map(g0, ops, ws)
+    velocity_map(ws)
+    length_creation_map(w, ops, ws)
+    least_squares_affine(ws.length_rate, ws.tension)
+    k = ops.S0.shape[1]
+    for c in range(3):
+        for i in range(ops.m):
+            acc = ws.mobile[c, i, k]
+            for j in range(k):
+                acc += ws.mobile[c, i, j] * ws.tension[j]
+            ws.velocity[c, i] = acc
+    u_out[:] = np.dot(ws.velocity, ops.F.T)
+
+
+@numba.njit(**JIT)
+def length_creation(x, tension, g0, w, ops, ws):
+    """Grid values of ε for a given tension (the residual of the tension solve)."""
+    shape_on_grid(x, ops, ws)
+    force_map(g0, ops, ws)
+    velocity_map(ws)
+    length_creation_map(w, ops, ws)
+    k = ops.S0.shape[1]
+    eps = ws.length_rate[:, k].copy()
+    for j in range(k):
+        eps += ws.length_rate[:, j] * tension[j]
+    return eps
+
+
+@numba.njit(**JIT)
+def relative_length_error(x, ops, ws):
+    """(L - 2π) / 2π with L = ∫|x'| ds by the trapezoid rule on the M-point grid.
+
+    |x'| is smooth and periodic, so the rule converges spectrally; for a
+    nearly inextensible loop it is exact far below the tolerances used.
+    """
+    ws.tangent[:] = np.dot(x, ops.S1.T)
+    total = 0.0
+    for i in range(ops.m):
+        total += np.sqrt(ws.tangent[0, i] ** 2 + ws.tangent[1, i] ** 2 + ws.tangent[2, i] ** 2)
+    return total / ops.m - 1.0

@@ -1,0 +1,82 @@
+"""The adaptive driver and the registered schemes on closed-form problems."""
+import numpy as np
+import pytest
+
+from loopsim import integrate as I
+from loopsim import problems
+
+METHODS = sorted(I.METHODS.items())
+
+
+def riccati_exact(rates, y0, t):
+    return y0 / (1.0 - rates * y0 * t)
+
+
+RATES = np.array([1.0, -0.5, 0.3, 2.0])
+Y0 = np.array([0.5, 1.0, -1.0, 0.1])
+
+
+def run(method, t_end, t_out, rtol=1e-8, atol=1e-10, h_init=-1.0, h_min=0.0, h_max=np.inf,
+        max_steps=100_000, rates=RATES, y0=Y0):
+    y_out = np.full((len(t_out), len(y0)), np.nan)
+    result = I.integrate(method, problems.RiccatiProblem(rates), y0, 0.0, t_end, np.asarray(t_out, float),
+                         rtol, atol, h_init, h_min, h_max, max_steps, 1.0, y_out)
+    return result, y_out
+
+
+def test_fehlberg_tableau_is_consistent():
+    np.testing.assert_allclose(I.RKF45_A.sum(axis=1), I.RKF45_C, atol=1e-15)
+    assert abs(I.RKF45_B5.sum() - 1) < 1e-15 and abs(I.RKF45_B4.sum() - 1) < 1e-15
+    # order conditions up to 4 for both weight sets (b·c^{q-1} = 1/q), 5 for B5
+    for weights, order in ((I.RKF45_B5, 5), (I.RKF45_B4, 4)):
+        for q in range(1, order + 1):
+            assert abs(weights @ I.RKF45_C ** (q - 1) - 1 / q) < 1e-14
+        assert abs(weights @ (I.RKF45_A @ I.RKF45_C[:5]) - 1 / 6) < 1e-14
+
+
+@pytest.mark.parametrize("name, method", METHODS)
+def test_adaptive_run_meets_tolerance_at_output_times(name, method):
+    t_out = np.linspace(0.0, 0.9, 7)
+    (status, t, y, n_acc, n_rej, n_rhs), y_out = run(method, 0.9, t_out)
+    assert status == I.OK and t == 0.9
+    exact = riccati_exact(RATES[None], Y0[None], t_out[:, None])
+    np.testing.assert_allclose(y_out, exact, rtol=1e-6, atol=1e-8)
+    np.testing.assert_array_equal(y_out[-1], y)
+    assert n_rhs >= 6 * n_acc
+
+
+@pytest.mark.parametrize("name, method", METHODS)
+def test_fixed_step_order(name, method):
+    """Global error of fixed steps (every step accepted) falls like h^5."""
+    errors = []
+    steps = [0.08, 0.04, 0.02]  # errors from 1e-10 down to 1e-13, above round-off
+    y0 = np.array([0.2, 1.0, -1.0, 0.1])
+    for h in steps:
+        (status, t, y, n_acc, *_), _ = run(method, 0.8, [], rtol=1e10, atol=1e10, h_init=h, h_max=h,
+                                           y0=y0)
+        assert status == I.OK and n_acc == round(0.8 / h)
+        errors.append(np.abs(y - riccati_exact(RATES, y0, 0.8)).max())
+    slopes = np.diff(np.log(errors)) / np.diff(np.log(steps))
+    assert np.all(slopes > 4.7), slopes
+
+
+@pytest.mark.parametrize("name, method", METHODS)
+def test_error_falls_with_tolerance(name, method):
+    errors = []
+    for rtol in (1e-4, 1e-6, 1e-8, 1e-10):
+        (status, t, y, *_), _ = run(method, 0.9, [], rtol=rtol, atol=rtol * 1e-2)
+        errors.append(np.abs(y - riccati_exact(RATES, Y0, 0.9)).max())
+    assert errors[-1] < 1e-8 and all(b < a for a, b in zip(errors, errors[1:]))
+
+
+@pytest.mark.parametrize("name, method", METHODS)
+def test_status_codes(name, method):
+    (status, t, *_), _ = run(method, 0.9, [], max_steps=5)
+    assert status == I.STEP_BUDGET and t < 0.9
+    (status, t, *_), _ = run(method, 0.9, [], h_min=0.5)
+    assert status == I.STEP_UNDERFLOW
+    # y' = y² from y = 1 blows up at t = 1: steps shrink until they underflow
+    (status, t, y, *_), _ = run(method, 2.0, [], rates=np.array([1.0]), y0=np.array([1.0]))
+    assert status in (I.STEP_UNDERFLOW, I.NON_FINITE) and 0.99 < t <= 1.0
+    (status, t, *_), _ = run(method, 1.0, [], y0=np.array([np.nan, 1.0, 1.0, 1.0]))
+    assert status == I.NON_FINITE and t == 0.0

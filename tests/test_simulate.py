@@ -1,0 +1,108 @@
+"""Whole trajectories through the API and the CLI."""
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pyarrow.parquet as pq
+import pytest
+
+import loopsim
+from loopsim import api, diagnostics as D, initial, io
+from loopsim.cli import main
+
+
+def test_stiff_circle_translates_rigidly_for_ten_time_units():
+    g0, theta_deg = 5.0, 50.0
+    theta = np.radians(theta_deg)
+    result = api.simulate(g0, theta_deg, perturbation=0.0, snapshots=3)
+    assert result.ok and result.t_final == 10.0
+    u0 = -np.array([0.0, g0 * np.sin(2 * theta) / 6, g0 * (7 - np.cos(2 * theta)) / 6])
+    expected = initial.inclined_circle(6, theta)
+    expected[:, 0] = u0 * 10.0
+    np.testing.assert_allclose(result.x_final, expected, atol=1e-8)
+    summary = result.summary()
+    assert abs(summary["theta_final_deg"] - theta_deg) < 1e-6
+    assert abs(summary["length_error"]) < 1e-10
+
+
+def test_length_is_conserved_and_summary_is_complete():
+    result = api.simulate(10.0, 30.0, snapshots=5)
+    summary = result.summary()
+    assert tuple(summary) == api.SUMMARY_FIELDS
+    assert summary["status"] == "ok"
+    assert max(abs(D.relative_length_error(x)) for x in result.x) < 1e-8
+    assert abs(summary["q0"] - 10.0 * 0.5 / 3) < 1e-12
+    assert summary["steps_accepted"] > 0 and summary["rhs_evals"] >= 6 * summary["steps_accepted"]
+    np.testing.assert_allclose(result.t, np.linspace(0, 10, 5))
+
+
+def test_reproducible_from_inputs():
+    a = api.simulate(60.0, 30.0, t_span=(0, 0.5), seed=7)
+    b = api.simulate(60.0, 30.0, t_span=(0, 0.5), seed=7)
+    np.testing.assert_array_equal(a.x, b.x)
+
+
+def test_failure_is_a_status_not_an_exception():
+    result = api.simulate(60.0, 30.0, t_span=(0, 1.0), max_steps=20)
+    assert result.status == "step budget exhausted" and not result.ok
+    assert result.t_final < 1.0 and result.summary()["t_final"] == result.t_final
+
+
+@pytest.mark.parametrize("kwargs, word", [
+    (dict(n=0), "n"), (dict(n=-3), "n"), (dict(g0=float("nan")), "g0"), (dict(g0=-1.0), "g0"),
+    (dict(theta0_deg=91.0), "theta0_deg"), (dict(theta0_deg=-0.5), "theta0_deg"),
+    (dict(rtol=0.0), "rtol"), (dict(perturbation=float("inf")), "perturbation"),
+    (dict(method="euler"), "method"), (dict(t_span=(0.0, -1.0)), "t_span"),
+])
+def test_api_rejects_bad_input(kwargs, word):
+    args = dict(g0=10.0, theta0_deg=30.0)
+    args.update(kwargs)
+    with pytest.raises(ValueError, match=word):
+        api.simulate(args.pop("g0"), args.pop("theta0_deg"), **args)
+
+
+@pytest.mark.parametrize("argv, word", [
+    (["run", "--g0", "10", "--theta0", "30", "--n", "-2"], "-2"),
+    (["run", "--g0", "nan", "--theta0", "30"], "nan"),
+    (["run", "--g0", "-4", "--theta0", "30"], "-4"),
+    (["run", "--g0", "10", "--theta0", "120"], "120"),
+    (["run", "--g0", "10", "--theta0", "30", "--bogus"], "--bogus"),
+    (["run", "--g0", "10"], "--theta0"),
+    (["stability", "--n-max", "0"], "0"),
+])
+def test_cli_bad_input_one_line_error(argv, word, capsys):
+    with pytest.raises(SystemExit) as exc:
+        sys.exit(main(argv))
+    assert exc.value.code == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and err.startswith("loopsim: error:") and word in err
+    assert "Traceback" not in err
+
+
+def test_cli_run_json_and_parquet(tmp_path, capsys):
+    out = tmp_path / "run.parquet"
+    code = main(["run", "--g0", "60", "--theta0", "30", "--t-end", "0.2", "--snapshots", "3",
+                 "--json", "--out", str(out)])
+    assert code == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert list(summary) == list(api.SUMMARY_FIELDS)
+    table = pq.read_table(out)
+    assert table.num_rows == 3 and table.column("x").type.list_size == 3 * 13
+    meta = io.read_metadata(out)
+    assert meta["summary"] == summary and meta["loopsim_version"] == loopsim.__version__
+    assert [p.name for p in tmp_path.iterdir()] == ["run.parquet"]  # no temporary left
+
+
+def test_cli_unwritable_output_is_a_clean_error(tmp_path, capsys):
+    code = main(["run", "--g0", "10", "--theta0", "30", "--t-end", "0.01",
+                 "--out", str(tmp_path / "missing" / "run.parquet")])
+    err = capsys.readouterr().err.strip()
+    assert code == 2 and len(err.splitlines()) == 1 and "missing" in err
+
+
+def test_cli_stability_and_module_entry_point():
+    done = subprocess.run([sys.executable, "-m", "loopsim", "stability", "--n-max", "12", "--json"],
+                          capture_output=True, text=True, check=True)
+    table = json.loads(done.stdout)["critical_q"]
+    assert table["1"] is None and abs(table["12"] - 14.56105439107) < 1e-10
