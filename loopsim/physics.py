@@ -31,11 +31,16 @@ from .config import JIT
 #: S0, S1, S2, S4: (M, K) synthesis of the value and 1st/2nd/4th derivative;
 #: F: (K, M) projection onto order n; P = S0 F and P1 = S1 F: (M, M)
 #: grid-to-grid projection and projected derivative.
-LoopOperators = collections.namedtuple("LoopOperators", "n m S0 S1 S2 S4 F P P1")
+#: S1T, S2T, S4T, FT: C-contiguous transposes for (3, ·) @ (·, ·) products.
+LoopOperators = collections.namedtuple(
+    "LoopOperators", "n m S0 S1 S2 S4 F P P1 S1T S2T S4T FT"
+)
 
-#: Per-case scratch arrays, so the right-hand side never allocates.
+#: Per-case scratch arrays, so the right-hand side never allocates.  Column
+#: blocks are stored (M, 3, J): grid point, component, column, so that each
+#: map is one matrix product (M, M) @ (M, 3J).
 Workspace = collections.namedtuple(
-    "Workspace", "tangent curvature x4 force mobile length_rate velocity tension"
+    "Workspace", "tangent curvature x4 raw force mobile dmobile length_rate velocity tension"
 )
 
 
@@ -47,11 +52,12 @@ def grid_size(n):
 def make_operators(n):
     """Build the constant matrices for truncation order n."""
     m = grid_size(n)
-    S = [np.ascontiguousarray(spectral.synthesis_matrix(n, m, d)) for d in (0, 1, 2, 4)]
-    F = np.ascontiguousarray(spectral.analysis_matrix(n, m))
+    S = [spectral.synthesis_matrix(n, m, d) for d in (0, 1, 2, 4)]
+    F = spectral.analysis_matrix(n, m)
+    c = np.ascontiguousarray
     return LoopOperators(
-        n, m, S[0], S[1], S[2], S[3], F,
-        np.ascontiguousarray(S[0] @ F), np.ascontiguousarray(S[1] @ F),
+        n, m, c(S[0]), c(S[1]), c(S[2]), c(S[3]), c(F), c(S[0] @ F), c(S[1] @ F),
+        c(S[1].T), c(S[2].T), c(S[3].T), c(F.T),
     )
 
 
@@ -61,17 +67,17 @@ def make_workspace(n):
     k = 2 * n + 1
     return Workspace(
         np.empty((3, m)), np.empty((3, m)), np.empty((3, m)),
-        np.empty((3, m, k + 1)), np.empty((3, m, k + 1)), np.empty((m, k + 1)),
-        np.empty((3, m)), np.empty(k),
+        np.empty((m, 3, k + 1)), np.empty((m, 3, k + 1)), np.empty((m, 3, k + 1)),
+        np.empty((m, 3, k + 1)), np.empty((m, k + 1)), np.empty((3, m)), np.empty(k),
     )
 
 
 @numba.njit(**JIT)
 def shape_on_grid(x, ops, ws):
     """Grid values of x', x'' and x'''' from coefficients x (3, K)."""
-    ws.tangent[:] = np.dot(x, ops.S1.T)
-    ws.curvature[:] = np.dot(x, ops.S2.T)
-    ws.x4[:] = np.dot(x, ops.S4.T)
+    np.dot(x, ops.S1T, ws.tangent)
+    np.dot(x, ops.S2T, ws.curvature)
+    np.dot(x, ops.S4T, ws.x4)
 
 
 @numba.njit(**JIT)
@@ -82,39 +88,38 @@ def force_map(g0, ops, ws):
     bending: the linear part), column K uses T = 0 (the affine part).
     """
     m, k = ops.m, ops.S0.shape[1]
-    raw = np.empty((m, k + 1))
-    for c in range(3):
-        t, kap = ws.tangent[c], ws.curvature[c]
-        for i in range(m):
+    raw = ws.raw
+    for i in range(m):
+        for c in range(3):
+            t, kap = ws.tangent[c, i], ws.curvature[c, i]
             for j in range(k):
-                raw[i, j] = t[i] * ops.S1[i, j] + kap[i] * ops.S0[i, j]
-            raw[i, k] = -ws.x4[c, i] - (g0 if c == 2 else 0.0)
-        ws.force[c] = np.dot(ops.P, raw)
+                raw[i, c, j] = t * ops.S1[i, j] + kap * ops.S0[i, j]
+            raw[i, c, k] = -ws.x4[c, i] - (g0 if c == 2 else 0.0)
+    np.dot(ops.P, raw.reshape((m, 3 * (k + 1))), ws.force.reshape((m, 3 * (k + 1))))
 
 
 @numba.njit(**JIT)
 def velocity_map(ws):
     """Map (2) before projection: u = f + (x'·f) x'  (stored in ws.mobile)."""
     t, f = ws.tangent, ws.force
-    m, cols = f.shape[1], f.shape[2]
+    m, cols = f.shape[0], f.shape[2]
     for i in range(m):
         for j in range(cols):
-            h = t[0, i] * f[0, i, j] + t[1, i] * f[1, i, j] + t[2, i] * f[2, i, j]
+            h = t[0, i] * f[i, 0, j] + t[1, i] * f[i, 1, j] + t[2, i] * f[i, 2, j]
             for c in range(3):
-                ws.mobile[c, i, j] = f[c, i, j] + h * t[c, i]
+                ws.mobile[i, c, j] = f[i, c, j] + h * t[c, i]
 
 
 @numba.njit(**JIT)
 def length_creation_map(w, ops, ws):
     """Map (3): ε = x'·(P_n u)' - w (1 - x'·x'), as a block of columns."""
-    t = ws.tangent
-    ws.length_rate[:] = 0.0
-    for c in range(3):
-        du = np.dot(ops.P1, ws.mobile[c])
-        for i in range(ops.m):
-            ws.length_rate[i, :] += t[c, i] * du[i, :]
-    k = ops.S0.shape[1]
-    for i in range(ops.m):
+    m, cols = ops.m, ws.mobile.shape[2]
+    np.dot(ops.P1, ws.mobile.reshape((m, 3 * cols)), ws.dmobile.reshape((m, 3 * cols)))
+    t, du = ws.tangent, ws.dmobile
+    k = cols - 1
+    for i in range(m):
+        for j in range(cols):
+            ws.length_rate[i, j] = t[0, i] * du[i, 0, j] + t[1, i] * du[i, 1, j] + t[2, i] * du[i, 2, j]
         stretch = t[0, i] ** 2 + t[1, i] ** 2 + t[2, i] ** 2
         ws.length_rate[i, k] -= w * (1.0 - stretch)
 
@@ -167,13 +172,13 @@ def loop_velocity(x, g0, w, ops, ws, u_out):
     length_creation_map(w, ops, ws)
     least_squares_affine(ws.length_rate, ws.tension)
     k = ops.S0.shape[1]
-    for c in range(3):
-        for i in range(ops.m):
-            acc = ws.mobile[c, i, k]
+    for i in range(ops.m):
+        for c in range(3):
+            acc = ws.mobile[i, c, k]
             for j in range(k):
-                acc += ws.mobile[c, i, j] * ws.tension[j]
+                acc += ws.mobile[i, c, j] * ws.tension[j]
             ws.velocity[c, i] = acc
-    u_out[:] = np.dot(ws.velocity, ops.F.T)
+    np.dot(ws.velocity, ops.FT, u_out)
 
 
 @numba.njit(**JIT)
@@ -197,7 +202,7 @@ def relative_length_error(x, ops, ws):
     |x'| is smooth and periodic, so the rule converges spectrally; for a
     nearly inextensible loop it is exact far below the tolerances used.
     """
-    ws.tangent[:] = np.dot(x, ops.S1.T)
+    np.dot(x, ops.S1T, ws.tangent)
     total = 0.0
     for i in range(ops.m):
         total += np.sqrt(ws.tangent[0, i] ** 2 + ws.tangent[1, i] ** 2 + ws.tangent[2, i] ** 2)

@@ -51,10 +51,10 @@ def test_each_map_matches_numpy_reference(n, rng):
     physics.shape_on_grid(x, ops, ws)
     physics.force_map(g0, ops, ws)
     weights = np.append(tension, 1.0)  # columns: tension basis, then the affine part
-    f_grid = ws.force @ weights
+    f_grid = (ws.force @ weights).T  # blocks are (M, 3, J)
     np.testing.assert_allclose(f_grid @ ops.F.T, f_ref, atol=1e-10 * np.abs(f_ref).max())
     physics.velocity_map(ws)
-    np.testing.assert_allclose((ws.mobile @ weights) @ ops.F.T, u_ref, atol=1e-10 * np.abs(u_ref).max())
+    np.testing.assert_allclose((ws.mobile @ weights).T @ ops.F.T, u_ref, atol=1e-10 * np.abs(u_ref).max())
     eps = physics.length_creation(x, tension, g0, w, ops, ws)
     # ε has order 2n: compare the interpolant of our M-point values with the fine-grid values
     eps_fine = naive.to_grid(naive.project(eps, 2 * n), 0, naive.FINE)
