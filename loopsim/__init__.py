@@ -8,6 +8,7 @@ operator), ``api`` (Python entry points), ``io`` (Parquet), ``cli``.
 __version__ = "0.1.0"
 
 from .api import SUMMARY_FIELDS, SimulationResult, evaluate_maps, simulate, stability_parameter
+from .ensemble import read_results
 
 __all__ = ["simulate", "SimulationResult", "evaluate_maps", "stability_parameter",
-           "SUMMARY_FIELDS", "__version__"]
+           "SUMMARY_FIELDS", "read_results", "__version__"]

@@ -82,24 +82,33 @@ class SimulationResult:
 
     def summary(self):
         """Dict with exactly the keys of ``SUMMARY_FIELDS``."""
-        x, u = self.x[-1], self.u[-1]
-        theta = diagnostics.tilt_deg(x)
-        t_max, t_min, s_max = diagnostics.tension_extremes(x, self.multiplier[-1])
-        com_velocity = u[:, 0]
-        values = dict(self.inputs)
-        values.update(
-            q0=stability_parameter(self.inputs["g0"], self.inputs["theta0_deg"]),
-            status=self.status, t_final=self.t_final,
-            steps_accepted=self.steps_accepted, steps_rejected=self.steps_rejected,
-            rhs_evals=self.rhs_evals, wall_s=self.wall_s, theta_final_deg=theta,
-            q_final=stability_parameter(self.inputs["g0"], theta),
-            aspect_ratio=diagnostics.aspect_ratio(x), axis_ratio=diagnostics.axis_ratio(x),
-            u_x=float(com_velocity[0]), u_y=float(com_velocity[1]), u_z=float(com_velocity[2]),
-            settling_angle_deg=diagnostics.settling_angle_deg(com_velocity),
-            tension_max=t_max, tension_min=t_min, s_tension_max=s_max,
-            length_error=diagnostics.relative_length_error(x),
+        return terminal_summary(
+            self.inputs, self.x[-1], self.u[-1], self.multiplier[-1], status=self.status,
+            t_final=self.t_final, steps_accepted=self.steps_accepted,
+            steps_rejected=self.steps_rejected, rhs_evals=self.rhs_evals, wall_s=self.wall_s,
         )
-        return {key: values[key] for key in SUMMARY_FIELDS}
+
+
+def terminal_summary(inputs, x, u, multiplier, **run_stats):
+    """Summary fields of a final shape x with velocity u and multiplier T.
+
+    ``inputs``: g0, theta0_deg, n, t_end, rtol, atol, w, perturbation, seed;
+    ``run_stats``: status, t_final, steps_accepted, steps_rejected, rhs_evals, wall_s.
+    """
+    theta = diagnostics.tilt_deg(x)
+    t_max, t_min, s_max = diagnostics.tension_extremes(x, multiplier)
+    com_velocity = u[:, 0]
+    values = dict(inputs, **run_stats)
+    values.update(
+        q0=stability_parameter(inputs["g0"], inputs["theta0_deg"]), theta_final_deg=theta,
+        q_final=stability_parameter(inputs["g0"], theta),
+        aspect_ratio=diagnostics.aspect_ratio(x), axis_ratio=diagnostics.axis_ratio(x),
+        u_x=float(com_velocity[0]), u_y=float(com_velocity[1]), u_z=float(com_velocity[2]),
+        settling_angle_deg=diagnostics.settling_angle_deg(com_velocity),
+        tension_max=t_max, tension_min=t_min, s_tension_max=s_max,
+        length_error=diagnostics.relative_length_error(x),
+    )
+    return {key: values[key] for key in SUMMARY_FIELDS}
 
 
 def evaluate_maps(x, g0, w=DEFAULT_W):

@@ -42,7 +42,9 @@ def _build_parser():
         description="Flexible elastic loops sedimenting in a viscous fluid "
         "(local slender-body theory, spectral in arc length).",
         epilog="Examples:\n  loopsim run --g0 60 --theta0 30\n"
-        "  loopsim run --g0 150 --theta0 60 --n 8 --json\n  loopsim stability --n-max 20",
+        "  loopsim run --g0 150 --theta0 60 --n 8 --json\n"
+        "  loopsim sweep --g0 10:350:8 --theta0 10:90:5 --out runs/phase --figure phase.png\n"
+        "  loopsim stability --n-max 20",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("--version", action="version", version=f"loopsim {__version__}")
@@ -72,6 +74,33 @@ def _build_parser():
     run.add_argument("--out", metavar="FILE.parquet",
                      help="write the snapshots (and the summary as metadata) to Parquet")
     run.add_argument("--json", action="store_true", help="print the summary as one JSON object")
+
+    sweep = commands.add_parser(
+        "sweep", help="run (or resume) an ensemble over (g0, theta0, n, seed) into Parquet",
+        description="Integrate many loops in parallel and write one row per case into "
+        "chunk files in DIR. Re-running the same command resumes; results are read with "
+        "loopsim.read_results(DIR).",
+        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
+    )
+    grid = sweep.add_argument_group("cases (a grid, or --cases FILE)")
+    grid.add_argument("--g0", metavar="START:STOP:NUM|v1,v2,...", help="g0 values")
+    grid.add_argument("--theta0", metavar="START:STOP:NUM|v1,v2,...", help="theta0 values (deg)")
+    grid.add_argument("--n", default=str(DEFAULT_N), metavar="N[,N...]", help="truncation orders")
+    grid.add_argument("--seeds", type=int, default=1, metavar="K", help="seeds 0..K-1 per point")
+    grid.add_argument("--cases", metavar="FILE", help="CSV/Parquet with columns g0, theta0_deg "
+                      "[, n, seed, perturbation] instead of a grid")
+    sweep.add_argument("--t-end", type=_real, default=DEFAULT_T_END, help="final time")
+    sweep.add_argument("--rtol", type=_real, default=DEFAULT_RTOL, help="relative tolerance")
+    sweep.add_argument("--atol", type=_real, default=DEFAULT_ATOL, help="absolute tolerance")
+    sweep.add_argument("--w", type=_real, default=DEFAULT_W, help="length-penalty rate")
+    sweep.add_argument("--perturbation", type=_real, default=DEFAULT_PERTURBATION, metavar="EPS",
+                       help="RMS size of the seeded initial perturbation")
+    sweep.add_argument("--method", default="rkf45", help="time integrator")
+    sweep.add_argument("--threads", type=int, default=None, help="threads (default: all cores)")
+    sweep.add_argument("--chunk-size", type=int, default=32, help="cases per chunk file")
+    sweep.add_argument("--out", required=True, metavar="DIR", help="sweep directory")
+    sweep.add_argument("--figure", metavar="PNG", help="also draw the phase diagram")
+    sweep.add_argument("--quiet", action="store_true", help="no progress line, only a summary")
 
     stability = commands.add_parser(
         "stability", help="critical q of the paper's linear stability operator",
@@ -108,6 +137,36 @@ def _cmd_run(args):
     return 0 if result.ok else EXIT_FAILED_RUN
 
 
+def _cmd_sweep(args):
+    from . import ensemble, figures
+
+    if args.cases:
+        if args.g0 or args.theta0:
+            raise ValueError("give either --cases or --g0/--theta0, not both")
+        orders = ensemble.parse_values(args.n, "--n", integer=True)
+        cases = ensemble.read_cases_file(args.cases, args.perturbation, orders[0])
+    else:
+        if not (args.g0 and args.theta0):
+            raise ValueError("a sweep needs --g0 and --theta0 (or --cases FILE)")
+        if args.seeds < 1:
+            raise ValueError(f"--seeds must be >= 1, got {args.seeds}")
+        cases = ensemble.grid_cases(
+            ensemble.parse_values(args.g0, "--g0"), ensemble.parse_values(args.theta0, "--theta0"),
+            ensemble.parse_values(args.n, "--n", integer=True), args.seeds, args.perturbation)
+    if args.threads is not None and args.threads < 1:
+        raise ValueError(f"--threads must be >= 1, got {args.threads}")
+    config = ensemble.SweepConfig(cases=cases, t_end=args.t_end, rtol=args.rtol, atol=args.atol,
+                                  w=args.w, method=args.method, chunk_size=args.chunk_size)
+    frame = ensemble.run_sweep(config, args.out, threads=args.threads, quiet=args.quiet,
+                               command_line=sys.argv)
+    counts = frame["regime"].value_counts().to_dict()
+    print(f"{len(frame)} cases in {args.out}: " + ", ".join(f"{k} {v}" for k, v in sorted(counts.items())))
+    if args.figure:
+        figures.phase_diagram(frame, args.figure)
+        print(f"phase diagram: {args.figure}")
+    return 0
+
+
 def _cmd_stability(args):
     from . import linear_stability
 
@@ -128,7 +187,7 @@ def _cmd_stability(args):
 def main(argv=None):
     parser = _build_parser()
     args = parser.parse_args(argv)
-    handlers = {"run": _cmd_run, "stability": _cmd_stability}
+    handlers = {"run": _cmd_run, "sweep": _cmd_sweep, "stability": _cmd_stability}
     try:
         return handlers[args.command](args)
     except (ValueError, OSError) as exc:

@@ -1,0 +1,54 @@
+"""Many trajectories of one truncation order in one parallel Numba kernel.
+
+Each case b integrates its own initial shape with its own workspace and
+writes only row b of the outputs, so the result does not depend on the
+number of threads or on the order in which threads take the cases.
+Use :func:`integrate_cases` (it sets the scheduling chunk size to one case,
+since 3D cases cost many times more than stable ones).
+"""
+import numba
+import numpy as np
+
+from . import physics
+from .config import JIT
+from .integrate import integrate
+from .problems import LoopProblem
+
+_PARALLEL_JIT = dict(JIT, parallel=True)
+
+
+@numba.njit(**_PARALLEL_JIT)
+def _integrate_cases(method, ops, g0, w, x0, t_end, rtol, atol, max_steps, length_tol,
+                     y_final, t_final, status, counts):
+    n = ops.n
+    no_output = np.empty(0)
+    for b in numba.prange(x0.shape[0]):
+        problem = LoopProblem(g0[b], w[b], ops, physics.make_workspace(n))
+        scratch = np.empty((0, x0.shape[1]))
+        result = integrate(method, problem, x0[b], 0.0, t_end[b], no_output, rtol[b], atol[b],
+                           -1.0, 0.0, np.inf, max_steps, length_tol, scratch)
+        status[b] = result[0]
+        t_final[b] = result[1]
+        y_final[b] = result[2]
+        counts[b, 0] = result[3]
+        counts[b, 1] = result[4]
+        counts[b, 2] = result[5]
+
+
+def integrate_cases(method, ops, g0, w, x0, t_end, rtol, atol, max_steps, length_tol):
+    """Integrate B cases (arrays of length B; x0 of shape (B, 3(2n+1))) in parallel.
+
+    Returns (y_final, t_final, status, counts) with counts[:, 0:3] = accepted
+    steps, rejected steps, RHS evaluations.
+    """
+    cases = x0.shape[0]
+    y_final = np.full_like(x0, np.nan)
+    t_final = np.zeros(cases)
+    status = np.zeros(cases, dtype=np.int64)
+    counts = np.zeros((cases, 3), dtype=np.int64)
+    as_array = lambda v: np.ascontiguousarray(np.broadcast_to(np.asarray(v, float), (cases,)))
+    with numba.parallel_chunksize(1):
+        _integrate_cases(method, ops, as_array(g0), as_array(w), np.ascontiguousarray(x0),
+                         as_array(t_end), as_array(rtol), as_array(atol), int(max_steps),
+                         float(length_tol), y_final, t_final, status, counts)
+    return y_final, t_final, status, counts

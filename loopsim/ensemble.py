@@ -1,0 +1,318 @@
+"""Ensemble sweeps: cases -> chunks -> Parquet files in a directory, resumable.
+
+A sweep directory holds ``sweep.json`` (the configuration, written first) and
+one ``chunk-KKKKK.parquet`` per finished chunk, each written under a
+temporary name and renamed into place.  A chunk is the unit of work: chunk k
+holds the cases with ``case_id % n_chunks == k`` (interleaved, so every
+chunk mixes cheap and costly corners of the grid).  Re-running the same sweep
+skips finished chunks; a different configuration in the same directory is
+refused.  No numerics here: integration is ``batch``, diagnostics ``api``.
+"""
+import dataclasses
+import glob
+import itertools
+import json
+import math
+import os
+import sys
+import time
+
+import numpy as np
+import pandas as pd
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+from . import api, batch, initial, integrate, io, problems, physics
+from .config import (
+    DEFAULT_ATOL, DEFAULT_LENGTH_TOL, DEFAULT_MAX_STEPS, DEFAULT_PERTURBATION, DEFAULT_RTOL,
+    DEFAULT_T_END, DEFAULT_W,
+)
+
+CONFIG_FILE = "sweep.json"
+CHUNK_PATTERN = "chunk-{:05d}.parquet"
+REGIMES = ("stable", "in-plane", "3d", "failed")
+
+
+@dataclasses.dataclass(frozen=True)
+class Thresholds:
+    """Regime thresholds (paper §6: stable = shape and tilt unchanged; in-plane = shape
+    changed, tilt unchanged; 3d = tilt changed).
+
+    tilt_change_deg: |θ_final − θ0| above which the tilt has changed.
+    shape_change: |aspect ratio_final − aspect ratio_initial| above which the shape has.
+    """
+
+    tilt_change_deg: float = 1.0
+    shape_change: float = 0.01
+
+
+def classify(theta0_deg, theta_final_deg, aspect_initial, aspect_final, ok, thresholds=Thresholds()):
+    """Regime label of one case: 'stable', 'in-plane', '3d' or 'failed' (status not ok)."""
+    if not ok:
+        return "failed"
+    if abs(theta_final_deg - theta0_deg) > thresholds.tilt_change_deg:
+        return "3d"
+    if abs(aspect_final - aspect_initial) > thresholds.shape_change:
+        return "in-plane"
+    return "stable"
+
+
+# ---- the table -----------------------------------------------------------
+_FLOAT = pa.float64()
+_INT = pa.int64()
+_SUMMARY_TYPES = {
+    "n": _INT, "seed": _INT, "status": pa.string(), "steps_accepted": _INT,
+    "steps_rejected": _INT, "rhs_evals": _INT,
+}
+#: The declared schema of every chunk (and of ``read_results``).
+RESULT_SCHEMA = pa.schema(
+    [pa.field("case_id", _INT)]
+    + [pa.field(name, _SUMMARY_TYPES.get(name, _FLOAT)) for name in api.SUMMARY_FIELDS]
+    + [
+        pa.field("regime", pa.string()),
+        pa.field("aspect_ratio_initial", _FLOAT),
+        pa.field("x_final", pa.list_(_FLOAT)),
+    ]
+)
+FIELD_NOTES = {
+    "wall_s": "share of the chunk's wall time x threads, in proportion to rhs_evals",
+    "x_final": "terminal shape coefficients, row-major (3, 2n+1): " + io.COEFFICIENT_LAYOUT,
+    "regime": "stable | in-plane | 3d | failed (see thresholds)",
+}
+
+
+# ---- configuration -------------------------------------------------------
+def parse_values(text, name, integer=False):
+    """'START:STOP:NUM' (linspace, ends included) or 'v1,v2,...' -> list of numbers."""
+    convert = int if integer else float
+    try:
+        if ":" in text:
+            start, stop, num = text.split(":")
+            num = int(num)
+            if num < 1:
+                raise ValueError
+            values = np.linspace(float(start), float(stop), num).tolist()
+        else:
+            values = [convert(v) for v in text.split(",") if v.strip()]
+        if not values or not all(math.isfinite(v) for v in values):
+            raise ValueError
+    except ValueError:
+        form = "v1,v2,..." if integer else "START:STOP:NUM or v1,v2,..."
+        raise ValueError(f"{name} must be {form}, got {text!r}") from None
+    return [convert(v) for v in values]
+
+
+@dataclasses.dataclass
+class SweepConfig:
+    """Everything that determines a sweep's results (stored in sweep.json)."""
+
+    cases: list  # of dicts: g0, theta0_deg, n, seed, perturbation
+    t_end: float = DEFAULT_T_END
+    rtol: float = DEFAULT_RTOL
+    atol: float = DEFAULT_ATOL
+    w: float = DEFAULT_W
+    method: str = "rkf45"
+    max_steps: int = DEFAULT_MAX_STEPS
+    length_tol: float = DEFAULT_LENGTH_TOL
+    chunk_size: int = 32
+    thresholds: Thresholds = Thresholds()
+
+    def as_dict(self):
+        return dataclasses.asdict(self)
+
+    @property
+    def n_chunks(self):
+        return max(1, math.ceil(len(self.cases) / self.chunk_size))
+
+
+def grid_cases(g0_values, theta0_values, n_values, seeds, perturbation=DEFAULT_PERTURBATION):
+    """Cartesian product, case_id in the order n, g0, θ0, seed."""
+    return [
+        dict(g0=float(g0), theta0_deg=float(theta), n=int(n), seed=int(seed),
+             perturbation=float(perturbation))
+        for n, g0, theta, seed in itertools.product(n_values, g0_values, theta0_values, range(seeds))
+    ]
+
+
+def read_cases_file(path, perturbation=DEFAULT_PERTURBATION, n=6):
+    """Cases from a CSV or Parquet table: columns g0, theta0_deg (required), n, seed, perturbation."""
+    try:
+        frame = pd.read_parquet(path) if str(path).endswith(".parquet") else pd.read_csv(path)
+    except Exception as exc:  # noqa: BLE001 - any reader failure is the same user error
+        raise ValueError(f"cannot read cases file {path!r}: {exc}".splitlines()[0]) from None
+    missing = {"g0", "theta0_deg"} - set(frame.columns)
+    if missing:
+        raise ValueError(f"cases file {path!r} lacks column(s) {sorted(missing)}")
+    frame = frame.assign(**{k: v for k, v in
+                            dict(n=n, seed=0, perturbation=perturbation).items() if k not in frame})
+    return [dict(g0=float(r.g0), theta0_deg=float(r.theta0_deg), n=int(r.n), seed=int(r.seed),
+                 perturbation=float(r.perturbation)) for r in frame.itertuples()]
+
+
+def validate(config):
+    """One-line ValueError naming the first bad value."""
+    if not config.cases:
+        raise ValueError("the sweep has no cases")
+    for case_id, case in enumerate(config.cases):
+        try:
+            api._finite("g0", case["g0"], low=0.0)
+            api._finite("theta0_deg", case["theta0_deg"], low=0.0, high=90.0)
+            api._integer("n", case["n"], 1)
+            api._integer("seed", case["seed"], 0)
+            api._finite("perturbation", case["perturbation"], low=0.0)
+        except ValueError as exc:
+            raise ValueError(f"case {case_id}: {exc}") from None
+    api._finite("t_end", config.t_end, low=0.0, low_open=True)
+    api._finite("rtol", config.rtol, low=0.0, low_open=True)
+    api._finite("atol", config.atol, low=0.0)
+    api._finite("w", config.w, low=0.0)
+    api._integer("chunk_size", config.chunk_size, 1)
+    if config.method not in integrate.METHODS:
+        raise ValueError(f"method must be one of {sorted(integrate.METHODS)}, got {config.method!r}")
+
+
+# ---- running ---------------------------------------------------------------
+def chunk_case_ids(config, chunk):
+    return list(range(chunk, len(config.cases), config.n_chunks))
+
+
+def run_chunk(config, chunk, threads):
+    """Integrate one chunk's cases; returns a pyarrow Table in RESULT_SCHEMA."""
+    ids = chunk_case_ids(config, chunk)
+    rows = {}
+    by_order = {}
+    for case_id in ids:
+        by_order.setdefault(config.cases[case_id]["n"], []).append(case_id)
+    start = time.perf_counter()
+    outputs = []
+    for n, members in sorted(by_order.items()):
+        ops = physics.make_operators(n)
+        cases = [config.cases[i] for i in members]
+        x0 = np.array([initial.initial_shape(n, math.radians(c["theta0_deg"]), c["perturbation"],
+                                             c["seed"]).ravel() for c in cases])
+        result = batch.integrate_cases(
+            integrate.METHODS[config.method], ops, [c["g0"] for c in cases], config.w, x0,
+            config.t_end, config.rtol, config.atol, config.max_steps, config.length_tol)
+        outputs.append((n, ops, members, cases, x0, result))
+    wall = time.perf_counter() - start
+    total_rhs = sum(int(r[5][3][:, 2].sum()) for r in outputs) or 1
+    for n, ops, members, cases, x0, (y_final, t_final, status, counts) in outputs:
+        for b, (case_id, case) in enumerate(zip(members, cases)):
+            problem = problems.make_loop_problem(n, case["g0"], config.w, ops)
+            x = y_final[b].reshape(3, 2 * n + 1)
+            if not np.all(np.isfinite(x)):
+                x = x0[b].reshape(3, 2 * n + 1)  # keep the row finite; status says why
+            u, multiplier = api._velocity_and_multiplier(problem, x)
+            inputs = dict(g0=case["g0"], theta0_deg=case["theta0_deg"], n=n, t_end=config.t_end,
+                          rtol=config.rtol, atol=config.atol, w=config.w,
+                          perturbation=case["perturbation"], seed=case["seed"])
+            summary = api.terminal_summary(
+                inputs, x, u, multiplier, status=integrate.STATUS_NAMES[int(status[b])],
+                t_final=float(t_final[b]), steps_accepted=int(counts[b, 0]),
+                steps_rejected=int(counts[b, 1]), rhs_evals=int(counts[b, 2]),
+                wall_s=wall * threads * counts[b, 2] / total_rhs,
+            )
+            aspect0 = api.diagnostics.aspect_ratio(x0[b].reshape(3, -1))
+            summary.update(
+                case_id=case_id, aspect_ratio_initial=aspect0, x_final=x.ravel().tolist(),
+                regime=classify(case["theta0_deg"], summary["theta_final_deg"], aspect0,
+                                summary["aspect_ratio"], int(status[b]) == integrate.OK,
+                                config.thresholds),
+            )
+            rows[case_id] = summary
+    ordered = [rows[i] for i in sorted(rows)]
+    return pa.Table.from_pylist(ordered, schema=RESULT_SCHEMA)
+
+
+class Progress:
+    """One status line on stderr: done/total, rate, ETA, failures (quiet: final line only)."""
+
+    def __init__(self, total, done, quiet=False, stream=sys.stderr):
+        self.total, self.done, self.failures = total, done, 0
+        self.quiet, self.stream = quiet, stream
+        self.start, self.started_with = time.perf_counter(), done
+        self.live = not quiet and stream.isatty()
+
+    def update(self, cases, failures):
+        self.done += cases
+        self.failures += failures
+        if self.live:
+            self.stream.write("\r" + self._line())
+            self.stream.flush()
+
+    def _line(self):
+        elapsed = time.perf_counter() - self.start
+        rate = (self.done - self.started_with) / elapsed if elapsed > 0 else 0.0
+        eta = (self.total - self.done) / rate if rate > 0 else float("nan")
+        eta_text = f"{eta:6.0f}s" if math.isfinite(eta) else "     ?"
+        return (f"cases {self.done}/{self.total} ({100 * self.done / self.total:3.0f}%) "
+                f"{rate:6.2f} case/s ETA {eta_text} failures {self.failures}")
+
+    def close(self):
+        self.stream.write(("\r" if self.live else "") + self._line() + "\n")
+        self.stream.flush()
+
+
+def _prepare_directory(out, config, command_line):
+    os.makedirs(out, exist_ok=True)
+    path = os.path.join(out, CONFIG_FILE)
+    stored = dict(config=config.as_dict(), command_line=command_line)
+    if os.path.exists(path):
+        with open(path) as handle:
+            previous = json.load(handle)["config"]
+        current = json.loads(json.dumps(config.as_dict()))
+        if previous != current:
+            changed = sorted(k for k in set(previous) | set(current) if previous.get(k) != current.get(k))
+            raise ValueError(f"{out!r} holds a different sweep (differs in: {', '.join(changed)}); "
+                             "use another --out")
+        return
+    tmp = path + ".tmp"
+    with open(tmp, "w") as handle:
+        json.dump(stored, handle, indent=1)
+    os.replace(tmp, path)
+
+
+def finished_chunks(out):
+    return {int(os.path.basename(p)[6:11]) for p in glob.glob(os.path.join(out, "chunk-*.parquet"))}
+
+
+def run_sweep(config, out, threads=None, quiet=False, command_line=None):
+    """Run (or resume) a sweep into directory ``out``; returns the results DataFrame."""
+    import numba
+
+    validate(config)
+    _prepare_directory(out, config, command_line or [])
+    threads = threads or numba.config.NUMBA_NUM_THREADS
+    numba.set_num_threads(threads)
+    done = finished_chunks(out)
+    progress = Progress(len(config.cases), sum(len(chunk_case_ids(config, c)) for c in done), quiet)
+    metadata = io.provenance(
+        sweep_config=config.as_dict(), thresholds=dataclasses.asdict(config.thresholds),
+        command_line=command_line or [], field_notes=FIELD_NOTES,
+    )
+    for chunk in range(config.n_chunks):
+        if chunk in done:
+            continue
+        table = run_chunk(config, chunk, threads).replace_schema_metadata(metadata)
+        io.write_table_atomically(table, os.path.join(out, CHUNK_PATTERN.format(chunk)))
+        failures = sum(1 for s in table.column("status").to_pylist() if s != "ok")
+        progress.update(table.num_rows, failures)
+    progress.close()
+    return read_results(out)
+
+
+def read_results(out):
+    """All finished cases of a sweep directory as a DataFrame sorted by case_id.
+
+    The sweep's metadata (configuration, thresholds, versions, command line)
+    is in ``frame.attrs["loopsim"]``.
+    """
+    paths = sorted(glob.glob(os.path.join(out, "chunk-*.parquet")))
+    if not os.path.isdir(out):
+        raise ValueError(f"no sweep directory at {out!r}")
+    if not paths:
+        return RESULT_SCHEMA.empty_table().to_pandas()
+    table = pa.concat_tables([pq.read_table(p, schema=RESULT_SCHEMA) for p in paths])
+    frame = table.to_pandas().sort_values("case_id", kind="stable").reset_index(drop=True)
+    frame.attrs["loopsim"] = io.read_metadata(paths[0])
+    return frame
