@@ -67,6 +67,7 @@ class SimulationResult:
     steps_rejected: int
     rhs_evals: int
     wall_s: float
+    length_error_max: float  # largest |relative length error| at accepted steps
 
     @property
     def ok(self):
@@ -172,7 +173,7 @@ def simulate(
     y_out = np.full((t_eval.size, x0.size), np.nan)
     h_init = -1.0 if first_step is None else _finite("first_step", first_step, 0.0, low_open=True)
     start = time.perf_counter()
-    status, t_final, y_final, n_acc, n_rej, n_rhs = _integrate.integrate(
+    status, t_final, y_final, n_acc, n_rej, n_rhs, worst_length = _integrate.integrate(
         _integrate.METHODS[method], problem, x0.ravel(), t0, t_end, t_eval, rtol, atol,
         h_init, float(min_step), float(max_step), max_steps, length_tol, y_out,
     )
@@ -193,5 +194,5 @@ def simulate(
         inputs=inputs, t=times, x=x, u=u, multiplier=multiplier,
         status=_integrate.STATUS_NAMES[status], status_code=int(status),
         t_final=float(t_final), steps_accepted=int(n_acc), steps_rejected=int(n_rej),
-        rhs_evals=int(n_rhs), wall_s=wall,
+        rhs_evals=int(n_rhs), wall_s=wall, length_error_max=float(worst_length),
     )

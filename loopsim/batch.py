@@ -19,7 +19,7 @@ _PARALLEL_JIT = dict(JIT, parallel=True)
 
 @numba.njit(**_PARALLEL_JIT)
 def _integrate_cases(method, ops, g0, w, x0, t_end, rtol, atol, max_steps, length_tol,
-                     y_final, t_final, status, counts):
+                     y_final, t_final, status, counts, worst_length):
     n = ops.n
     no_output = np.empty(0)
     for b in numba.prange(x0.shape[0]):
@@ -33,22 +33,25 @@ def _integrate_cases(method, ops, g0, w, x0, t_end, rtol, atol, max_steps, lengt
         counts[b, 0] = result[3]
         counts[b, 1] = result[4]
         counts[b, 2] = result[5]
+        worst_length[b] = result[6]
 
 
 def integrate_cases(method, ops, g0, w, x0, t_end, rtol, atol, max_steps, length_tol):
     """Integrate B cases (arrays of length B; x0 of shape (B, 3(2n+1))) in parallel.
 
-    Returns (y_final, t_final, status, counts) with counts[:, 0:3] = accepted
-    steps, rejected steps, RHS evaluations.
+    Returns (y_final, t_final, status, counts, worst_length): counts[:, 0:3] =
+    accepted steps, rejected steps, RHS evaluations; worst_length the largest
+    relative length error met along each trajectory.
     """
     cases = x0.shape[0]
     y_final = np.full_like(x0, np.nan)
     t_final = np.zeros(cases)
     status = np.zeros(cases, dtype=np.int64)
     counts = np.zeros((cases, 3), dtype=np.int64)
+    worst_length = np.zeros(cases)
     as_array = lambda v: np.ascontiguousarray(np.broadcast_to(np.asarray(v, float), (cases,)))
     with numba.parallel_chunksize(1):
         _integrate_cases(method, ops, as_array(g0), as_array(w), np.ascontiguousarray(x0),
                          as_array(t_end), as_array(rtol), as_array(atol), int(max_steps),
-                         float(length_tol), y_final, t_final, status, counts)
-    return y_final, t_final, status, counts
+                         float(length_tol), y_final, t_final, status, counts, worst_length)
+    return y_final, t_final, status, counts, worst_length

@@ -29,4 +29,4 @@ DEFAULT_PERTURBATION = 1e-3
 DEFAULT_SEED = 0
 DEFAULT_MAX_STEPS = 2_000_000
 #: Relative length error beyond which a run stops with status LENGTH_ERROR.
-DEFAULT_LENGTH_TOL = 0.05
+DEFAULT_LENGTH_TOL = 0.25

@@ -71,6 +71,7 @@ RESULT_SCHEMA = pa.schema(
     + [
         pa.field("regime", pa.string()),
         pa.field("aspect_ratio_initial", _FLOAT),
+        pa.field("length_error_max", _FLOAT),
         pa.field("x_final", pa.list_(_FLOAT)),
     ]
 )
@@ -78,6 +79,7 @@ FIELD_NOTES = {
     "wall_s": "share of the chunk's wall time x threads, in proportion to rhs_evals",
     "x_final": "terminal shape coefficients, row-major (3, 2n+1): " + io.COEFFICIENT_LAYOUT,
     "regime": "stable | in-plane | 3d | failed (see thresholds)",
+    "length_error_max": "largest |relative length error| along the trajectory (transient)",
 }
 
 
@@ -196,7 +198,7 @@ def run_chunk(config, chunk, threads):
         outputs.append((n, ops, members, cases, x0, result))
     wall = time.perf_counter() - start
     total_rhs = sum(int(r[5][3][:, 2].sum()) for r in outputs) or 1
-    for n, ops, members, cases, x0, (y_final, t_final, status, counts) in outputs:
+    for n, ops, members, cases, x0, (y_final, t_final, status, counts, worst) in outputs:
         for b, (case_id, case) in enumerate(zip(members, cases)):
             problem = problems.make_loop_problem(n, case["g0"], config.w, ops)
             x = y_final[b].reshape(3, 2 * n + 1)
@@ -215,6 +217,7 @@ def run_chunk(config, chunk, threads):
             aspect0 = api.diagnostics.aspect_ratio(x0[b].reshape(3, -1))
             summary.update(
                 case_id=case_id, aspect_ratio_initial=aspect0, x_final=x.ravel().tolist(),
+                length_error_max=float(worst[b]),
                 regime=classify(case["theta0_deg"], summary["theta_final_deg"], aspect0,
                                 summary["aspect_ratio"], int(status[b]) == integrate.OK,
                                 config.thresholds),
@@ -255,6 +258,8 @@ class Progress:
 
 def _prepare_directory(out, config, command_line):
     os.makedirs(out, exist_ok=True)
+    for stale in glob.glob(os.path.join(out, ".tmp-*")):  # a write cut short by a kill
+        os.remove(stale)
     path = os.path.join(out, CONFIG_FILE)
     stored = dict(config=config.as_dict(), command_line=command_line)
     if os.path.exists(path):

@@ -19,14 +19,14 @@ def phase_diagram(frame, path, n=None):
     """g0 against θ0 coloured by regime, with the paper's linear-stability curve
     g0 = 3 q_c / sin θ0 (q_c = 14.561)."""
     q_crit = linear_stability.critical_q(20)
-    fig, ax = plt.subplots(figsize=(5.2, 4.0), constrained_layout=True)
+    fig, ax = plt.subplots(figsize=(6.6, 4.0), constrained_layout=True)
     for regime, style in REGIME_STYLE.items():
         rows = frame[frame["regime"] == regime]
         if len(rows):
-            ax.scatter(rows["theta0_deg"], rows["g0"], s=22, edgecolors="none", **style)
+            ax.scatter(rows["theta0_deg"], rows["g0"], s=22, linewidths=1.2, **style)
     theta = np.linspace(1.0, 90.0, 300)
     ax.plot(theta, 3 * q_crit / np.sin(np.radians(theta)), "k-", lw=1.2,
-            label=f"paper's linear stability, q = {q_crit:.3f}")
+            label=f"paper's linear\nstability, q = {q_crit:.3f}")
     ax.set_xlim(0, 92)
     ax.set_ylim(0, 1.05 * frame["g0"].max())
     ax.set_xlabel(r"initial tilt $\theta_0$ (deg)")
@@ -34,6 +34,6 @@ def phase_diagram(frame, path, n=None):
     orders = sorted(frame["n"].unique())
     ax.set_title(f"sedimentation regimes, n = {', '.join(map(str, orders))}, "
                  f"t = {frame['t_end'].max():g}", fontsize=10)
-    ax.legend(fontsize=8, frameon=False, loc="upper right")
+    ax.legend(fontsize=8, frameon=False, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     fig.savefig(path, dpi=200)
     plt.close(fig)

@@ -168,7 +168,9 @@ def integrate(method, problem, y0, t0, t_end, t_out, rtol, atol, h_init, h_min,
     h_init <= 0 selects the starting step automatically.
     constraint_tol: stop with LENGTH_ERROR once |constraint_error| exceeds it.
 
-    Returns (status, t, y, steps_accepted, steps_rejected, rhs_evals).
+    Returns (status, t, y, steps_accepted, steps_rejected, rhs_evals,
+    max_constraint_error), the last the largest |constraint_error| seen at
+    accepted steps (for a loop: the worst transient relative length error).
     """
     ny = y0.shape[0]
     y = y0.copy()
@@ -180,10 +182,11 @@ def integrate(method, problem, y0, t0, t_end, t_out, rtol, atol, h_init, h_min,
     n_acc = 0
     n_rej = 0
     n_rhs = 1
+    worst = 0.0
     t = t0
     rhs(problem, y, k[0])
     if not _all_finite(k[0]) or not _all_finite(y):
-        return NON_FINITE, t, y, n_acc, n_rej, n_rhs
+        return NON_FINITE, t, y, n_acc, n_rej, n_rhs, worst
     i_out = 0
     while i_out < t_out.shape[0] and t_out[i_out] <= t0:
         y_out[i_out] = y
@@ -195,11 +198,11 @@ def integrate(method, problem, y0, t0, t_end, t_out, rtol, atol, h_init, h_min,
         n_rhs += 1
     while t < t_end:
         if n_acc + n_rej >= max_steps:
-            return STEP_BUDGET, t, y, n_acc, n_rej, n_rhs
+            return STEP_BUDGET, t, y, n_acc, n_rej, n_rhs, worst
         floor = max(h_min, 10.0 * np.finfo(np.float64).eps * abs(t))
         if h < floor:
             status = STEP_UNDERFLOW if _all_finite(y) else NON_FINITE
-            return status, t, y, n_acc, n_rej, n_rhs
+            return status, t, y, n_acc, n_rej, n_rhs, worst
         # land exactly on the next output time or on t_end
         t_stop = t_end
         if i_out < t_out.shape[0] and t_out[i_out] < t_stop:
@@ -221,13 +224,14 @@ def integrate(method, problem, y0, t0, t_end, t_out, rtol, atol, h_init, h_min,
         rhs(problem, y, k[0])
         n_rhs += 1
         if not _all_finite(k[0]):
-            return NON_FINITE, t, y, n_acc, n_rej, n_rhs
-        if abs(constraint_error(problem, y)) > constraint_tol:
-            return LENGTH_ERROR, t, y, n_acc, n_rej, n_rhs
+            return NON_FINITE, t, y, n_acc, n_rej, n_rhs, worst
+        worst = max(worst, abs(constraint_error(problem, y)))
+        if worst > constraint_tol:
+            return LENGTH_ERROR, t, y, n_acc, n_rej, n_rhs, worst
         while i_out < t_out.shape[0] and t_out[i_out] <= t:
             y_out[i_out] = y
             i_out += 1
         # a step shortened to hit an output time says nothing about the next h
         factor = step_factor(err_norm, order)
         h = min(h_max, max(h, h_try * factor) if clipped else h_try * factor)
-    return OK, t, y, n_acc, n_rej, n_rhs
+    return OK, t, y, n_acc, n_rej, n_rhs, worst
