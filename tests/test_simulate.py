@@ -49,6 +49,16 @@ def test_failure_is_a_status_not_an_exception():
     assert result.t_final < 1.0 and result.summary()["t_final"] == result.t_final
 
 
+def test_length_error_stops_the_run_and_is_recorded():
+    """A strongly unstable loop at n = 4 loses length transiently (truncation); a tight
+    length_tol turns that into a status, and the worst error is recorded."""
+    result = api.simulate(150.0, 60.0, n=4, t_span=(0, 0.5), length_tol=1e-4)
+    assert result.status == "length error too large" and result.t_final < 0.5
+    assert result.length_error_max > 1e-4
+    free = api.simulate(150.0, 60.0, n=4, t_span=(0, 0.5))
+    assert free.ok and free.length_error_max > 1e-4
+
+
 @pytest.mark.parametrize("kwargs, word", [
     (dict(n=0), "n"), (dict(n=-3), "n"), (dict(g0=float("nan")), "g0"), (dict(g0=-1.0), "g0"),
     (dict(theta0_deg=91.0), "theta0_deg"), (dict(theta0_deg=-0.5), "theta0_deg"),
