@@ -36,6 +36,17 @@ def _real(text):
     return value
 
 
+def _add_integration_options(parser):
+    """Options shared by every command that integrates loops."""
+    parser.add_argument("--t-end", type=_real, default=DEFAULT_T_END, help="final time")
+    parser.add_argument("--rtol", type=_real, default=DEFAULT_RTOL, help="relative tolerance")
+    parser.add_argument("--atol", type=_real, default=DEFAULT_ATOL, help="absolute tolerance")
+    parser.add_argument("--w", type=_real, default=DEFAULT_W, help="length-penalty rate")
+    parser.add_argument("--perturbation", type=_real, default=DEFAULT_PERTURBATION, metavar="EPS",
+                        help="RMS size of the seeded initial perturbation (0: exact circle)")
+    parser.add_argument("--method", default="rkf45", help="time integrator")
+
+
 def _build_parser():
     parser = _Parser(
         prog="loopsim",
@@ -61,16 +72,10 @@ def _build_parser():
     run.add_argument("--theta0", type=_real, required=True, metavar="DEG",
                      help="initial tilt of the loop's plane to the horizontal, in [0, 90] degrees")
     run.add_argument("--n", type=int, default=DEFAULT_N, help="Fourier truncation order (>= 1)")
-    run.add_argument("--t-end", type=_real, default=DEFAULT_T_END, help="final time")
-    run.add_argument("--rtol", type=_real, default=DEFAULT_RTOL, help="relative tolerance")
-    run.add_argument("--atol", type=_real, default=DEFAULT_ATOL, help="absolute tolerance")
-    run.add_argument("--w", type=_real, default=DEFAULT_W, help="length-penalty rate")
-    run.add_argument("--perturbation", type=_real, default=DEFAULT_PERTURBATION, metavar="EPS",
-                     help="RMS size of the seeded initial perturbation (0: exact circle)")
+    _add_integration_options(run)
     run.add_argument("--seed", type=int, default=DEFAULT_SEED, help="perturbation seed (>= 0)")
     run.add_argument("--snapshots", type=int, default=2, metavar="K",
                      help="number of equally spaced snapshots stored, ends included")
-    run.add_argument("--method", default="rkf45", help="time integrator")
     run.add_argument("--out", metavar="FILE.parquet",
                      help="write the snapshots (and the summary as metadata) to Parquet")
     run.add_argument("--json", action="store_true", help="print the summary as one JSON object")
@@ -89,13 +94,7 @@ def _build_parser():
     grid.add_argument("--seeds", type=int, default=1, metavar="K", help="seeds 0..K-1 per point")
     grid.add_argument("--cases", metavar="FILE", help="CSV/Parquet with columns g0, theta0_deg "
                       "[, n, seed, perturbation] instead of a grid")
-    sweep.add_argument("--t-end", type=_real, default=DEFAULT_T_END, help="final time")
-    sweep.add_argument("--rtol", type=_real, default=DEFAULT_RTOL, help="relative tolerance")
-    sweep.add_argument("--atol", type=_real, default=DEFAULT_ATOL, help="absolute tolerance")
-    sweep.add_argument("--w", type=_real, default=DEFAULT_W, help="length-penalty rate")
-    sweep.add_argument("--perturbation", type=_real, default=DEFAULT_PERTURBATION, metavar="EPS",
-                       help="RMS size of the seeded initial perturbation")
-    sweep.add_argument("--method", default="rkf45", help="time integrator")
+    _add_integration_options(sweep)
     sweep.add_argument("--threads", type=int, default=None, help="threads (default: all cores)")
     sweep.add_argument("--chunk-size", type=int, default=32, help="cases per chunk file")
     sweep.add_argument("--out", required=True, metavar="DIR", help="sweep directory")
