@@ -29,7 +29,7 @@ def stability_parameter(g0, theta_deg):
 
 
 # ---- input validation: one-line messages naming the value -----------------
-def _finite(name, value, low=-math.inf, high=math.inf, low_open=False):
+def check_real(name, value, low=-math.inf, high=math.inf, low_open=False):
     if isinstance(value, bool) or not isinstance(value, numbers.Real):
         raise ValueError(f"{name} must be a real number, got {value!r}")
     value = float(value)
@@ -40,7 +40,7 @@ def _finite(name, value, low=-math.inf, high=math.inf, low_open=False):
     return value
 
 
-def _integer(name, value, low):
+def check_integer(name, value, low):
     if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < low:
         raise ValueError(f"{name} must be an integer >= {low}, got {value!r}")
     return int(value)
@@ -143,23 +143,23 @@ def simulate(
 
     Never raises for a failed integration: see ``result.status``.
     """
-    g0 = _finite("g0", g0, low=0.0)
-    theta0_deg = _finite("theta0_deg", theta0_deg, low=0.0, high=90.0)
-    n = _integer("n", n, 1)
-    t0, t_end = (_finite("t_span[0]", t_span[0]), _finite("t_span[1]", t_span[1]))
+    g0 = check_real("g0", g0, low=0.0)
+    theta0_deg = check_real("theta0_deg", theta0_deg, low=0.0, high=90.0)
+    n = check_integer("n", n, 1)
+    t0, t_end = (check_real("t_span[0]", t_span[0]), check_real("t_span[1]", t_span[1]))
     if not t_end > t0:
         raise ValueError(f"t_span must be increasing, got {tuple(t_span)!r}")
-    rtol = _finite("rtol", rtol, low=0.0, low_open=True)
-    atol = _finite("atol", atol, low=0.0)
-    w = _finite("w", w, low=0.0)
-    perturbation = _finite("perturbation", perturbation, low=0.0)
-    seed = _integer("seed", seed, 0)
-    max_steps = _integer("max_steps", max_steps, 1)
-    length_tol = _finite("length_tol", length_tol, low=0.0, low_open=True)
+    rtol = check_real("rtol", rtol, low=0.0, low_open=True)
+    atol = check_real("atol", atol, low=0.0)
+    w = check_real("w", w, low=0.0)
+    perturbation = check_real("perturbation", perturbation, low=0.0)
+    seed = check_integer("seed", seed, 0)
+    max_steps = check_integer("max_steps", max_steps, 1)
+    length_tol = check_real("length_tol", length_tol, low=0.0, low_open=True)
     if method not in _integrate.METHODS:
         raise ValueError(f"method must be one of {sorted(_integrate.METHODS)}, got {method!r}")
     if t_eval is None:
-        snapshots = _integer("snapshots", snapshots, 1)
+        snapshots = check_integer("snapshots", snapshots, 1)
         t_eval = np.linspace(t0, t_end, snapshots) if snapshots > 1 else np.array([t_end])
     t_eval = np.asarray(t_eval, dtype=float)
     if t_eval.ndim != 1 or not np.all(np.isfinite(t_eval)) or np.any(np.diff(t_eval) <= 0) \
@@ -171,7 +171,7 @@ def simulate(
     x0 = initial.initial_shape(n, math.radians(theta0_deg), perturbation, seed)
     problem = problems.make_loop_problem(n, g0, w)
     y_out = np.full((t_eval.size, x0.size), np.nan)
-    h_init = -1.0 if first_step is None else _finite("first_step", first_step, 0.0, low_open=True)
+    h_init = -1.0 if first_step is None else check_real("first_step", first_step, 0.0, low_open=True)
     start = time.perf_counter()
     status, t_final, y_final, n_acc, n_rej, n_rhs, worst_length = _integrate.integrate(
         _integrate.METHODS[method], problem, x0.ravel(), t0, t_end, t_eval, rtol, atol,

@@ -157,18 +157,18 @@ def validate(config):
         raise ValueError("the sweep has no cases")
     for case_id, case in enumerate(config.cases):
         try:
-            api._finite("g0", case["g0"], low=0.0)
-            api._finite("theta0_deg", case["theta0_deg"], low=0.0, high=90.0)
-            api._integer("n", case["n"], 1)
-            api._integer("seed", case["seed"], 0)
-            api._finite("perturbation", case["perturbation"], low=0.0)
+            api.check_real("g0", case["g0"], low=0.0)
+            api.check_real("theta0_deg", case["theta0_deg"], low=0.0, high=90.0)
+            api.check_integer("n", case["n"], 1)
+            api.check_integer("seed", case["seed"], 0)
+            api.check_real("perturbation", case["perturbation"], low=0.0)
         except ValueError as exc:
             raise ValueError(f"case {case_id}: {exc}") from None
-    api._finite("t_end", config.t_end, low=0.0, low_open=True)
-    api._finite("rtol", config.rtol, low=0.0, low_open=True)
-    api._finite("atol", config.atol, low=0.0)
-    api._finite("w", config.w, low=0.0)
-    api._integer("chunk_size", config.chunk_size, 1)
+    api.check_real("t_end", config.t_end, low=0.0, low_open=True)
+    api.check_real("rtol", config.rtol, low=0.0, low_open=True)
+    api.check_real("atol", config.atol, low=0.0)
+    api.check_real("w", config.w, low=0.0)
+    api.check_integer("chunk_size", config.chunk_size, 1)
     if config.method not in integrate.METHODS:
         raise ValueError(f"method must be one of {sorted(integrate.METHODS)}, got {config.method!r}")
 
