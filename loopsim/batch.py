@@ -21,12 +21,12 @@ _PARALLEL_JIT = dict(JIT, parallel=True)
 def _integrate_cases(method, ops, g0, w, x0, t_end, rtol, atol, max_steps, length_tol,
                      y_final, t_final, status, counts, worst_length):
     n = ops.n
-    no_output = np.empty(0)
+    no_output_times = np.empty(0)
+    no_output_rows = np.empty((0, x0.shape[1]))  # read-only: no output times, nothing written
     for b in numba.prange(x0.shape[0]):
         problem = LoopProblem(g0[b], w[b], ops, physics.make_workspace(n))
-        scratch = np.empty((0, x0.shape[1]))
-        result = integrate(method, problem, x0[b], 0.0, t_end[b], no_output, rtol[b], atol[b],
-                           -1.0, 0.0, np.inf, max_steps, length_tol, scratch)
+        result = integrate(method, problem, x0[b], 0.0, t_end[b], no_output_times, rtol[b],
+                           atol[b], -1.0, 0.0, np.inf, max_steps, length_tol, no_output_rows)
         status[b] = result[0]
         t_final[b] = result[1]
         y_final[b] = result[2]

@@ -161,15 +161,21 @@ def least_squares_affine(a, out):
 
 
 @numba.njit(**JIT)
+def compose_maps(x, g0, w, ops, ws):
+    """Maps (1)-(3) for shape x: the affine map T -> ε as the block ws.length_rate."""
+    shape_on_grid(x, ops, ws)
+    force_map(g0, ops, ws)
+    velocity_map(ws)
+    length_creation_map(w, ops, ws)
+
+
+@numba.njit(**JIT)
 def loop_velocity(x, g0, w, ops, ws, u_out):
     """Velocity coefficients u (3, K) of the shape x (3, K); tension left in ws.tension.
 
     The least-squares solve destroys ws.length_rate; the residual is not kept.
     """
-    shape_on_grid(x, ops, ws)
-    force_map(g0, ops, ws)
-    velocity_map(ws)
-    length_creation_map(w, ops, ws)
+    compose_maps(x, g0, w, ops, ws)
     least_squares_affine(ws.length_rate, ws.tension)
     k = ops.S0.shape[1]
     for i in range(ops.m):
@@ -184,10 +190,7 @@ def loop_velocity(x, g0, w, ops, ws, u_out):
 @numba.njit(**JIT)
 def length_creation(x, tension, g0, w, ops, ws):
     """Grid values of ε for a given tension (the residual of the tension solve)."""
-    shape_on_grid(x, ops, ws)
-    force_map(g0, ops, ws)
-    velocity_map(ws)
-    length_creation_map(w, ops, ws)
+    compose_maps(x, g0, w, ops, ws)
     k = ops.S0.shape[1]
     eps = ws.length_rate[:, k].copy()
     for j in range(k):
