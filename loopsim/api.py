@@ -10,7 +10,8 @@ from . import diagnostics, initial, physics, problems
 from . import integrate as _integrate
 from .config import (
     DEFAULT_ATOL, DEFAULT_LENGTH_TOL, DEFAULT_MAX_STEPS, DEFAULT_N,
-    DEFAULT_PERTURBATION, DEFAULT_RTOL, DEFAULT_SEED, DEFAULT_T_END, DEFAULT_W,
+    DEFAULT_PERTURBATION, DEFAULT_RTOL, DEFAULT_SEED, DEFAULT_STEADY_INTERVAL, DEFAULT_T_END,
+    DEFAULT_W,
 )
 
 #: Summary fields, in order; they are also the ensemble table's columns.
@@ -71,7 +72,12 @@ class SimulationResult:
 
     @property
     def ok(self):
-        return self.status_code == _integrate.OK
+        return self.status_code in _integrate.SUCCESS
+
+    @property
+    def stop_reason(self):
+        """'t_end', 'steady' (early stop at the terminal state) or the failure."""
+        return _integrate.STOP_REASONS[self.status_code]
 
     @property
     def x_final(self):
@@ -130,14 +136,16 @@ def simulate(
     snapshots=2, rtol=DEFAULT_RTOL, atol=DEFAULT_ATOL, w=DEFAULT_W,
     perturbation=DEFAULT_PERTURBATION, seed=DEFAULT_SEED, method="rkf45",
     max_steps=DEFAULT_MAX_STEPS, length_tol=DEFAULT_LENGTH_TOL, first_step=None,
-    max_step=math.inf, min_step=0.0,
+    max_step=math.inf, min_step=0.0, steady_tol=None, steady_interval=DEFAULT_STEADY_INTERVAL,
 ):
     """Simulate a loop released as a perturbed circle tilted by ``theta0_deg``.
 
     Parameters follow ``scipy.integrate.solve_ivp`` where they overlap:
     ``t_span`` (t0, t_end), ``t_eval`` (output times; default ``snapshots``
     equally spaced times including both ends), ``rtol``/``atol``, ``method``,
-    ``first_step``, ``max_step``, ``min_step``.  ``g0`` is gravity over
+    ``first_step``, ``max_step``, ``min_step``.  ``steady_tol`` (default off)
+    stops early at a steady terminal state (``integrate.step_options``).
+    ``g0`` is gravity over
     stiffness, ``w`` the length-penalty rate, ``perturbation`` the RMS size of
     the seeded initial perturbation (``initial`` module).
 
@@ -171,11 +179,17 @@ def simulate(
     x0 = initial.initial_shape(n, math.radians(theta0_deg), perturbation, seed)
     problem = problems.make_loop_problem(n, g0, w)
     y_out = np.full((t_eval.size, x0.size), np.nan)
-    h_init = -1.0 if first_step is None else check_real("first_step", first_step, 0.0, low_open=True)
+    if first_step is not None:
+        check_real("first_step", first_step, 0.0, low_open=True)
+    steady_interval = check_real("steady_interval", steady_interval, 0.0, low_open=True)
+    if steady_tol is not None:
+        steady_tol = check_real("steady_tol", steady_tol, 0.0, low_open=True)
+    options = _integrate.step_options(
+        rtol, atol, first_step, min_step, max_step, max_steps, length_tol,
+        steady_interval if steady_tol is not None else 0.0, steady_tol or 0.0)
     start = time.perf_counter()
     status, t_final, y_final, n_acc, n_rej, n_rhs, worst_length = _integrate.integrate(
-        _integrate.METHODS[method], problem, x0.ravel(), t0, t_end, t_eval, rtol, atol,
-        h_init, float(min_step), float(max_step), max_steps, length_tol, y_out,
+        _integrate.METHODS[method], problem, x0.ravel(), t0, t_end, t_eval, options, y_out,
     )
     wall = time.perf_counter() - start
 

@@ -18,15 +18,15 @@ _PARALLEL_JIT = dict(JIT, parallel=True)
 
 
 @numba.njit(**_PARALLEL_JIT)
-def _integrate_cases(method, ops, g0, w, x0, t_end, rtol, atol, max_steps, length_tol,
-                     y_final, t_final, status, counts, worst_length):
+def _integrate_cases(method, ops, g0, w, x0, t_end, options, y_final, t_final, status, counts,
+                     worst_length):
     n = ops.n
     no_output_times = np.empty(0)
     no_output_rows = np.empty((0, x0.shape[1]))  # read-only: no output times, nothing written
     for b in numba.prange(x0.shape[0]):
         problem = LoopProblem(g0[b], w[b], ops, physics.make_workspace(n))
-        result = integrate(method, problem, x0[b], 0.0, t_end[b], no_output_times, rtol[b],
-                           atol[b], -1.0, 0.0, np.inf, max_steps, length_tol, no_output_rows)
+        result = integrate(method, problem, x0[b], 0.0, t_end[b], no_output_times, options,
+                           no_output_rows)
         status[b] = result[0]
         t_final[b] = result[1]
         y_final[b] = result[2]
@@ -36,8 +36,9 @@ def _integrate_cases(method, ops, g0, w, x0, t_end, rtol, atol, max_steps, lengt
         worst_length[b] = result[6]
 
 
-def integrate_cases(method, ops, g0, w, x0, t_end, rtol, atol, max_steps, length_tol):
-    """Integrate B cases (arrays of length B; x0 of shape (B, 3(2n+1))) in parallel.
+def integrate_cases(method, ops, g0, w, x0, t_end, options):
+    """Integrate B cases (g0, w, t_end: arrays of length B or scalars; x0 of shape
+    (B, 3(2n+1))) in parallel with the driver ``options`` (``integrate.step_options``).
 
     Returns (y_final, t_final, status, counts, worst_length): counts[:, 0:3] =
     accepted steps, rejected steps, RHS evaluations; worst_length the largest
@@ -52,6 +53,5 @@ def integrate_cases(method, ops, g0, w, x0, t_end, rtol, atol, max_steps, length
     as_array = lambda v: np.ascontiguousarray(np.broadcast_to(np.asarray(v, float), (cases,)))
     with numba.parallel_chunksize(1):
         _integrate_cases(method, ops, as_array(g0), as_array(w), np.ascontiguousarray(x0),
-                         as_array(t_end), as_array(rtol), as_array(atol), int(max_steps),
-                         float(length_tol), y_final, t_final, status, counts, worst_length)
+                         as_array(t_end), options, y_final, t_final, status, counts, worst_length)
     return y_final, t_final, status, counts, worst_length

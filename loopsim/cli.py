@@ -95,6 +95,9 @@ def _build_parser():
     grid.add_argument("--cases", metavar="FILE", help="CSV/Parquet with columns g0, theta0_deg "
                       "[, n, seed, perturbation] instead of a grid")
     _add_integration_options(sweep)
+    sweep.add_argument("--no-early-stop", action="store_true",
+                       help="always integrate to --t-end (default: stop once the shape and tilt "
+                       "are steady, see README)")
     sweep.add_argument("--threads", type=int, default=None, help="threads (default: all cores)")
     sweep.add_argument("--chunk-size", type=int, default=32, help="cases per chunk file")
     sweep.add_argument("--out", required=True, metavar="DIR", help="sweep directory")
@@ -155,7 +158,8 @@ def _cmd_sweep(args):
     if args.threads is not None and args.threads < 1:
         raise ValueError(f"--threads must be >= 1, got {args.threads}")
     config = ensemble.SweepConfig(cases=cases, t_end=args.t_end, rtol=args.rtol, atol=args.atol,
-                                  w=args.w, method=args.method, chunk_size=args.chunk_size)
+                                  w=args.w, method=args.method, chunk_size=args.chunk_size,
+                                  early_stop=not args.no_early_stop)
     frame = ensemble.run_sweep(config, args.out, threads=args.threads, quiet=args.quiet,
                                command_line=sys.argv)
     counts = frame["regime"].value_counts().to_dict()

@@ -30,3 +30,9 @@ DEFAULT_SEED = 0
 DEFAULT_MAX_STEPS = 2_000_000
 #: Relative length error beyond which a run stops with status LENGTH_ERROR.
 DEFAULT_LENGTH_TOL = 0.25
+#: Early stop at the terminal state: every DEFAULT_STEADY_INTERVAL time units the
+#: covariance eigenvalues and |n_z| of the plane normal are compared with their
+#: values one interval earlier; two consecutive changes below DEFAULT_STEADY_TOL
+#: make the state steady (see README "Terminal state").
+DEFAULT_STEADY_INTERVAL = 0.5
+DEFAULT_STEADY_TOL = 1e-6

@@ -25,7 +25,7 @@ import pyarrow.parquet as pq
 from . import api, batch, initial, integrate, io, problems, physics
 from .config import (
     DEFAULT_ATOL, DEFAULT_LENGTH_TOL, DEFAULT_MAX_STEPS, DEFAULT_PERTURBATION, DEFAULT_RTOL,
-    DEFAULT_T_END, DEFAULT_W,
+    DEFAULT_STEADY_INTERVAL, DEFAULT_STEADY_TOL, DEFAULT_T_END, DEFAULT_W,
 )
 
 CONFIG_FILE = "sweep.json"
@@ -70,6 +70,7 @@ RESULT_SCHEMA = pa.schema(
     + [pa.field(name, _SUMMARY_TYPES.get(name, _FLOAT)) for name in api.SUMMARY_FIELDS]
     + [
         pa.field("regime", pa.string()),
+        pa.field("stop_reason", pa.string()),
         pa.field("aspect_ratio_initial", _FLOAT),
         pa.field("length_error_max", _FLOAT),
         pa.field("x_final", pa.list_(_FLOAT)),
@@ -79,6 +80,7 @@ FIELD_NOTES = {
     "wall_s": "share of the chunk's wall time x threads, in proportion to rhs_evals",
     "x_final": "terminal shape coefficients, row-major (3, 2n+1): " + io.COEFFICIENT_LAYOUT,
     "regime": "stable | in-plane | 3d | failed (see thresholds)",
+    "stop_reason": "t_end | steady (terminal state reached early) | the failure",
     "length_error_max": "largest |relative length error| along the trajectory (transient)",
 }
 
@@ -117,7 +119,16 @@ class SweepConfig:
     max_steps: int = DEFAULT_MAX_STEPS
     length_tol: float = DEFAULT_LENGTH_TOL
     chunk_size: int = 32
+    early_stop: bool = True
+    steady_interval: float = DEFAULT_STEADY_INTERVAL
+    steady_tol: float = DEFAULT_STEADY_TOL
     thresholds: Thresholds = Thresholds()
+
+    def step_options(self):
+        return integrate.step_options(
+            self.rtol, self.atol, max_steps=self.max_steps, constraint_tol=self.length_tol,
+            steady_interval=self.steady_interval if self.early_stop else 0.0,
+            steady_tol=self.steady_tol)
 
     def as_dict(self):
         return dataclasses.asdict(self)
@@ -194,7 +205,7 @@ def run_chunk(config, chunk, threads):
                                              c["seed"]).ravel() for c in cases])
         result = batch.integrate_cases(
             integrate.METHODS[config.method], ops, [c["g0"] for c in cases], config.w, x0,
-            config.t_end, config.rtol, config.atol, config.max_steps, config.length_tol)
+            config.t_end, config.step_options())
         outputs.append((n, ops, members, cases, x0, result))
     wall = time.perf_counter() - start
     total_rhs = sum(int(r[5][3][:, 2].sum()) for r in outputs) or 1
@@ -218,8 +229,9 @@ def run_chunk(config, chunk, threads):
             summary.update(
                 case_id=case_id, aspect_ratio_initial=aspect0, x_final=x.ravel().tolist(),
                 length_error_max=float(worst[b]),
+                stop_reason=integrate.STOP_REASONS[int(status[b])],
                 regime=classify(case["theta0_deg"], summary["theta_final_deg"], aspect0,
-                                summary["aspect_ratio"], int(status[b]) == integrate.OK,
+                                summary["aspect_ratio"], int(status[b]) in integrate.SUCCESS,
                                 config.thresholds),
             )
             rows[case_id] = summary

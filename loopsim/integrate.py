@@ -14,11 +14,13 @@ Adding a scheme: give it a method id in ``METHODS``, a step function with the
 signature of :func:`rkf45_attempt` and a branch in :func:`_attempt`; every
 test parametrised over ``METHODS`` then covers it.
 """
+import collections
+
 import numba
 import numpy as np
 
 from .config import JIT
-from .problems import constraint_error, rhs
+from .problems import constraint_error, rhs, steady_invariants
 
 # ---- status codes --------------------------------------------------------
 OK = 0
@@ -26,13 +28,26 @@ STEP_BUDGET = 1
 STEP_UNDERFLOW = 2
 NON_FINITE = 3
 LENGTH_ERROR = 4
+STEADY = 5  # success: stopped early in a steady terminal state
+SUCCESS = (OK, STEADY)
 STATUS_NAMES = {
     OK: "ok",
     STEP_BUDGET: "step budget exhausted",
     STEP_UNDERFLOW: "step size underflow",
     NON_FINITE: "non-finite state",
     LENGTH_ERROR: "length error too large",
+    STEADY: "ok",
 }
+#: Why a run stopped, per status.
+STOP_REASONS = {**STATUS_NAMES, OK: "t_end", STEADY: "steady"}
+
+#: Consecutive quiet check intervals that make a steady state.
+STEADY_WINDOWS = 2
+
+StepOptions = collections.namedtuple(
+    "StepOptions",
+    "rtol atol first_step min_step max_step max_steps constraint_tol steady_interval steady_tol",
+)
 
 # ---- methods ---------------------------------------------------------------
 RKF45 = 0
@@ -157,21 +172,37 @@ def initial_step(problem, y0, f0, rtol, atol, error_order, h_max):
     return min(100.0 * h0, h1, h_max)
 
 
+def step_options(rtol, atol, first_step=None, min_step=0.0, max_step=np.inf,
+                 max_steps=1_000_000, constraint_tol=np.inf, steady_interval=0.0,
+                 steady_tol=0.0):
+    """Driver options (scipy names where they exist) as a ``StepOptions`` tuple.
+
+    first_step: None selects the starting step automatically.
+    constraint_tol: stop with LENGTH_ERROR once |constraint_error| exceeds it.
+    steady_interval, steady_tol: every ``steady_interval`` time units compare
+    the problem's invariants (``problems.steady_invariants``) with their
+    values one interval earlier; when no invariant moved by more than
+    ``steady_tol`` over STEADY_WINDOWS consecutive intervals, stop with status
+    STEADY.  steady_interval <= 0 disables the check.
+    """
+    return StepOptions(float(rtol), float(atol), -1.0 if first_step is None else float(first_step),
+                       float(min_step), float(max_step), int(max_steps), float(constraint_tol),
+                       float(steady_interval), float(steady_tol))
+
+
 @numba.njit(**JIT)
-def integrate(method, problem, y0, t0, t_end, t_out, rtol, atol, h_init, h_min,
-              h_max, max_steps, constraint_tol, y_out):
-    """Integrate dy/dt = rhs(problem, y) from t0 to t_end.
+def integrate(method, problem, y0, t0, t_end, t_out, options, y_out):
+    """Integrate dy/dt = rhs(problem, y) from t0 to t_end with ``options`` (:func:`step_options`).
 
     t_out: sorted output times in [t0, t_end]; the state at t_out[i] is written
     to y_out[i] (steps are shortened to land on them exactly).  Rows of
     y_out for times not reached are left untouched.
-    h_init <= 0 selects the starting step automatically.
-    constraint_tol: stop with LENGTH_ERROR once |constraint_error| exceeds it.
 
     Returns (status, t, y, steps_accepted, steps_rejected, rhs_evals,
     max_constraint_error), the last the largest |constraint_error| seen at
     accepted steps (for a loop: the worst transient relative length error).
     """
+    rtol, atol = options.rtol, options.atol
     ny = y0.shape[0]
     y = y0.copy()
     y_new = np.empty(ny)
@@ -191,15 +222,19 @@ def integrate(method, problem, y0, t0, t_end, t_out, rtol, atol, h_init, h_min,
     while i_out < t_out.shape[0] and t_out[i_out] <= t0:
         y_out[i_out] = y
         i_out += 1
-    if h_init > 0.0:
-        h = min(h_init, h_max)
+    if options.first_step > 0.0:
+        h = min(options.first_step, options.max_step)
     else:
-        h = initial_step(problem, y, k[0], rtol, atol, order, h_max)
+        h = initial_step(problem, y, k[0], rtol, atol, order, options.max_step)
         n_rhs += 1
+    watch_steady = options.steady_interval > 0.0
+    next_check = t0 + options.steady_interval
+    previous = steady_invariants(problem, y)
+    quiet_windows = 0
     while t < t_end:
-        if n_acc + n_rej >= max_steps:
+        if n_acc + n_rej >= options.max_steps:
             return STEP_BUDGET, t, y, n_acc, n_rej, n_rhs, worst
-        floor = max(h_min, 10.0 * np.finfo(np.float64).eps * abs(t))
+        floor = max(options.min_step, 10.0 * np.finfo(np.float64).eps * abs(t))
         if h < floor:
             status = STEP_UNDERFLOW if _all_finite(y) else NON_FINITE
             return status, t, y, n_acc, n_rej, n_rhs, worst
@@ -226,12 +261,28 @@ def integrate(method, problem, y0, t0, t_end, t_out, rtol, atol, h_init, h_min,
         if not _all_finite(k[0]):
             return NON_FINITE, t, y, n_acc, n_rej, n_rhs, worst
         worst = max(worst, abs(constraint_error(problem, y)))
-        if worst > constraint_tol:
+        if worst > options.constraint_tol:
             return LENGTH_ERROR, t, y, n_acc, n_rej, n_rhs, worst
         while i_out < t_out.shape[0] and t_out[i_out] <= t:
             y_out[i_out] = y
             i_out += 1
+        if watch_steady and t >= next_check and t < t_end:
+            current = steady_invariants(problem, y)
+            quiet_windows = quiet_windows + 1 if max_abs_difference(current, previous) \
+                <= options.steady_tol else 0
+            if quiet_windows >= STEADY_WINDOWS:
+                return STEADY, t, y, n_acc, n_rej, n_rhs, worst
+            previous = current
+            next_check = t + options.steady_interval
         # a step shortened to hit an output time says nothing about the next h
         factor = step_factor(err_norm, order)
-        h = min(h_max, max(h, h_try * factor) if clipped else h_try * factor)
+        h = min(options.max_step, max(h, h_try * factor) if clipped else h_try * factor)
     return OK, t, y, n_acc, n_rej, n_rhs, worst
+
+
+@numba.njit(**JIT)
+def max_abs_difference(a, b):
+    worst = 0.0
+    for i in range(a.shape[0]):
+        worst = max(worst, abs(a[i] - b[i]))
+    return worst

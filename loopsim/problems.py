@@ -39,6 +39,11 @@ def constraint_error(problem, y):
     raise NotImplementedError("only callable from jitted code")
 
 
+def steady_invariants(problem, y):
+    """Quantities whose standstill defines a steady (terminal) state."""
+    raise NotImplementedError("only callable from jitted code")
+
+
 def _is(problem_type, cls):
     return isinstance(problem_type, types.BaseNamedTuple) and problem_type.instance_class is cls
 
@@ -71,3 +76,30 @@ def _constraint_error(problem, y):
         def no_constraint(problem, y):
             return 0.0
         return no_constraint
+
+
+@overload(steady_invariants, jit_options=JIT)
+def _steady_invariants(problem, y):
+    if _is(problem, LoopProblem):
+        def loop_invariants(problem, y):
+            # covariance eigenvalues (size and shape; invariant under rigid motions and
+            # arc-length shifts) and |n_z| of the best-fit plane's normal (the tilt)
+            k = y.shape[0] // 3
+            x = y.reshape((3, k))
+            cov = np.zeros((3, 3))
+            for a in range(3):
+                for b in range(3):
+                    acc = 0.0
+                    for j in range(1, k):
+                        acc += x[a, j] * x[b, j]
+                    cov[a, b] = 0.5 * acc
+            values, vectors = np.linalg.eigh(cov)
+            out = np.empty(4)
+            out[:3] = values
+            out[3] = abs(vectors[2, 0])
+            return out
+        return loop_invariants
+    if _is(problem, RiccatiProblem):
+        def riccati_invariants(problem, y):
+            return y.copy()
+        return riccati_invariants

@@ -66,6 +66,7 @@ def test_sweep_schema_round_trip_and_thread_reproducibility(tmp_path):
     x = np.asarray(row["x_final"]).reshape(3, 2 * row["n"] + 1)
     assert abs(loopsim.diagnostics.aspect_ratio(x) - row["aspect_ratio"]) < 1e-12
     assert set(one["regime"]) <= set(ensemble.REGIMES)
+    assert set(one["stop_reason"]) == {"t_end"}  # t_end = 0.5: too short to call steady
     # results equal a single API run of the same case
     single = loopsim.simulate(row["g0"], row["theta0_deg"], n=4, t_span=(0, 0.5), seed=0)
     np.testing.assert_array_equal(single.x_final.ravel(), x.ravel())

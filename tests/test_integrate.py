@@ -19,8 +19,9 @@ Y0 = np.array([0.5, 1.0, -1.0, 0.1])
 def run(method, t_end, t_out, rtol=1e-8, atol=1e-10, h_init=-1.0, h_min=0.0, h_max=np.inf,
         max_steps=100_000, rates=RATES, y0=Y0):
     y_out = np.full((len(t_out), len(y0)), np.nan)
-    result = I.integrate(method, problems.RiccatiProblem(rates), y0, 0.0, t_end, np.asarray(t_out, float),
-                         rtol, atol, h_init, h_min, h_max, max_steps, 1.0, y_out)
+    options = I.step_options(rtol, atol, h_init if h_init > 0 else None, h_min, h_max, max_steps)
+    result = I.integrate(method, problems.RiccatiProblem(rates), y0, 0.0, t_end,
+                         np.asarray(t_out, float), options, y_out)
     return result, y_out
 
 
@@ -80,3 +81,17 @@ def test_status_codes(name, method):
     assert status in (I.STEP_UNDERFLOW, I.NON_FINITE) and 0.99 < t <= 1.0
     (status, t, *_), _ = run(method, 1.0, [], y0=np.array([np.nan, 1.0, 1.0, 1.0]))
     assert status == I.NON_FINITE and t == 0.0
+
+
+@pytest.mark.parametrize("name, method", METHODS)
+def test_steady_state_stop(name, method):
+    """y' = a y² with a < 0 decays like 1/(|a| t): its change per interval falls below
+    the tolerance at a predictable time, and not before."""
+    rates, y0 = np.array([-1.0]), np.array([1.0])
+    options = I.step_options(1e-10, 1e-12, steady_interval=0.5, steady_tol=1e-3)
+    status, t, y, *_ = I.integrate(method, problems.RiccatiProblem(rates), y0, 0.0, 100.0,
+                                   np.empty(0), options, np.empty((0, 1)))
+    assert status == I.STEADY
+    # y(t) = 1/(1+t): change over 0.5 is ≈ 0.5/(1+t)², below 1e-3 once t ≳ 21.4;
+    # two quiet intervals in a row are needed, checked every ≥ 0.5
+    assert 21.0 < t < 24.0

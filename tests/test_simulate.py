@@ -116,3 +116,22 @@ def test_cli_stability_and_module_entry_point():
                           capture_output=True, text=True, check=True)
     table = json.loads(done.stdout)["critical_q"]
     assert table["1"] is None and abs(table["12"] - 14.56105439107) < 1e-10
+
+
+@pytest.mark.parametrize("g0, theta_deg", [(10.0, 30.0), (60.0, 30.0)])
+def test_early_stop_at_steady_state_matches_full_run(g0, theta_deg):
+    """A stable and an in-plane loop: stopping once steady changes the terminal shape
+    diagnostics by less than 1e-5 compared with integrating to t = 10."""
+    early = api.simulate(g0, theta_deg, steady_tol=1e-6)
+    full = api.simulate(g0, theta_deg)
+    assert early.ok and early.stop_reason == "steady" and early.t_final < 9.0
+    assert full.stop_reason == "t_end" and early.summary()["status"] == "ok"
+    e, f = early.summary(), full.summary()
+    for key in ("aspect_ratio", "theta_final_deg", "tension_max"):
+        assert abs(e[key] - f[key]) < 1e-5 * max(1.0, abs(f[key])), key
+
+
+def test_early_stop_waits_for_a_deforming_loop():
+    """A tolerance far below the shape's rate of change never fires."""
+    result = api.simulate(150.0, 60.0, t_span=(0, 1.0), steady_tol=1e-12)
+    assert result.stop_reason == "t_end" and result.t_final == 1.0
