@@ -8,7 +8,7 @@ operator), ``api`` (Python entry points), ``io`` (Parquet), ``cli``.
 __version__ = "0.1.0"
 
 from .api import SUMMARY_FIELDS, SimulationResult, evaluate_maps, simulate, stability_parameter
-from .ensemble import read_results
+from .ensemble import read_results, read_snapshots
 
 __all__ = ["simulate", "SimulationResult", "evaluate_maps", "stability_parameter",
-           "SUMMARY_FIELDS", "read_results", "__version__"]
+           "SUMMARY_FIELDS", "read_results", "read_snapshots", "__version__"]

@@ -98,6 +98,10 @@ def _build_parser():
     sweep.add_argument("--no-early-stop", action="store_true",
                        help="always integrate to --t-end (default: stop once the shape and tilt "
                        "are steady, see README)")
+    sweep.add_argument("--snapshots-for", metavar="CASE_IDS", default="",
+                       help="case ids (v1,v2,...) whose trajectories are stored as snapshots")
+    sweep.add_argument("--snapshots", type=int, default=101, metavar="K",
+                       help="snapshots per selected trajectory")
     sweep.add_argument("--threads", type=int, default=None, help="threads (default: all cores)")
     sweep.add_argument("--chunk-size", type=int, default=32, help="cases per chunk file")
     sweep.add_argument("--out", required=True, metavar="DIR", help="sweep directory")
@@ -159,7 +163,11 @@ def _cmd_sweep(args):
         raise ValueError(f"--threads must be >= 1, got {args.threads}")
     config = ensemble.SweepConfig(cases=cases, t_end=args.t_end, rtol=args.rtol, atol=args.atol,
                                   w=args.w, method=args.method, chunk_size=args.chunk_size,
-                                  early_stop=not args.no_early_stop)
+                                  early_stop=not args.no_early_stop,
+                                  snapshots_for=ensemble.parse_values(
+                                      args.snapshots_for, "--snapshots-for", integer=True)
+                                  if args.snapshots_for else [],
+                                  snapshot_count=args.snapshots)
     frame = ensemble.run_sweep(config, args.out, threads=args.threads, quiet=args.quiet,
                                command_line=sys.argv)
     counts = frame["regime"].value_counts().to_dict()

@@ -30,6 +30,7 @@ from .config import (
 
 CONFIG_FILE = "sweep.json"
 CHUNK_PATTERN = "chunk-{:05d}.parquet"
+SNAPSHOT_PATTERN = "snapshots-{:05d}.parquet"
 REGIMES = ("stable", "in-plane", "3d", "failed")
 
 
@@ -120,6 +121,8 @@ class SweepConfig:
     length_tol: float = DEFAULT_LENGTH_TOL
     chunk_size: int = 32
     early_stop: bool = True
+    snapshots_for: list = dataclasses.field(default_factory=list)  # case ids
+    snapshot_count: int = 101
     steady_interval: float = DEFAULT_STEADY_INTERVAL
     steady_tol: float = DEFAULT_STEADY_TOL
     thresholds: Thresholds = Thresholds()
@@ -180,6 +183,11 @@ def validate(config):
     api.check_real("atol", config.atol, low=0.0)
     api.check_real("w", config.w, low=0.0)
     api.check_integer("chunk_size", config.chunk_size, 1)
+    api.check_integer("snapshot_count", config.snapshot_count, 2)
+    for case_id in config.snapshots_for:
+        if not 0 <= case_id < len(config.cases):
+            raise ValueError(f"--snapshots-for names case {case_id}, but the sweep has cases "
+                             f"0..{len(config.cases) - 1}")
     if config.method not in integrate.METHODS:
         raise ValueError(f"method must be one of {sorted(integrate.METHODS)}, got {config.method!r}")
 
@@ -189,54 +197,106 @@ def chunk_case_ids(config, chunk):
     return list(range(chunk, len(config.cases), config.n_chunks))
 
 
+def _initial_shape(case):
+    return initial.initial_shape(case["n"], math.radians(case["theta0_deg"]),
+                                 case["perturbation"], case["seed"])
+
+
+def _result_row(config, case_id, case, x0, x, status_code, counts, worst_length, wall_s, t_final):
+    """One row of RESULT_SCHEMA for a finished case with final coefficients x (3, 2n+1)."""
+    n = case["n"]
+    if not np.all(np.isfinite(x)):
+        x = x0  # keep the row finite; the status says why
+    problem = problems.make_loop_problem(n, case["g0"], config.w)
+    u, multiplier = api._velocity_and_multiplier(problem, x)
+    inputs = dict(g0=case["g0"], theta0_deg=case["theta0_deg"], n=n, t_end=config.t_end,
+                  rtol=config.rtol, atol=config.atol, w=config.w,
+                  perturbation=case["perturbation"], seed=case["seed"])
+    row = api.terminal_summary(
+        inputs, x, u, multiplier, status=integrate.STATUS_NAMES[status_code], t_final=t_final,
+        steps_accepted=int(counts[0]), steps_rejected=int(counts[1]), rhs_evals=int(counts[2]),
+        wall_s=wall_s,
+    )
+    aspect0 = api.diagnostics.aspect_ratio(x0)
+    row.update(
+        case_id=case_id, aspect_ratio_initial=aspect0, x_final=x.ravel().tolist(),
+        length_error_max=float(worst_length), stop_reason=integrate.STOP_REASONS[status_code],
+        regime=classify(case["theta0_deg"], row["theta_final_deg"], aspect0, row["aspect_ratio"],
+                        status_code in integrate.SUCCESS, config.thresholds),
+    )
+    return row
+
+
+def _traced_case(config, case_id):
+    """A case with snapshots: its row and trajectory come from one ``api.simulate`` run,
+    so they agree exactly (its steps land on the snapshot times)."""
+    case = config.cases[case_id]
+    result = api.simulate(
+        case["g0"], case["theta0_deg"], n=case["n"], t_span=(0.0, config.t_end),
+        snapshots=config.snapshot_count, rtol=config.rtol, atol=config.atol, w=config.w,
+        perturbation=case["perturbation"], seed=case["seed"], method=config.method,
+        max_steps=config.max_steps, length_tol=config.length_tol,
+        steady_tol=config.steady_tol if config.early_stop else None,
+        steady_interval=config.steady_interval)
+    row = _result_row(config, case_id, case, result.x[0], result.x_final, result.status_code,
+                      (result.steps_accepted, result.steps_rejected, result.rhs_evals),
+                      result.length_error_max, result.wall_s, result.t_final)
+    table = io.trajectory_table(result).replace_schema_metadata(None)
+    for name in ("x", "multiplier"):  # orders differ between cases: variable-length lists
+        table = table.set_column(table.schema.get_field_index(name), name,
+                                 table.column(name).cast(pa.list_(_FLOAT)))
+    return row, table.add_column(0, "case_id", pa.array([case_id] * table.num_rows, _INT))
+
+
 def run_chunk(config, chunk, threads):
-    """Integrate one chunk's cases; returns a pyarrow Table in RESULT_SCHEMA."""
+    """Integrate one chunk's cases.
+
+    Returns (results Table in RESULT_SCHEMA, snapshots Table or None).  Cases
+    without snapshots run in the parallel batch kernel, grouped by n; their
+    ``wall_s`` is the batch's wall time x threads shared in proportion to RHS
+    evaluations.
+    """
     ids = chunk_case_ids(config, chunk)
-    rows = {}
+    traced = sorted(set(ids) & set(config.snapshots_for))
     by_order = {}
     for case_id in ids:
-        by_order.setdefault(config.cases[case_id]["n"], []).append(case_id)
+        if case_id not in traced:
+            by_order.setdefault(config.cases[case_id]["n"], []).append(case_id)
     start = time.perf_counter()
     outputs = []
     for n, members in sorted(by_order.items()):
-        ops = physics.make_operators(n)
         cases = [config.cases[i] for i in members]
-        x0 = np.array([initial.initial_shape(n, math.radians(c["theta0_deg"]), c["perturbation"],
-                                             c["seed"]).ravel() for c in cases])
+        x0 = np.array([_initial_shape(c).ravel() for c in cases])
         result = batch.integrate_cases(
-            integrate.METHODS[config.method], ops, [c["g0"] for c in cases], config.w, x0,
-            config.t_end, config.step_options())
-        outputs.append((n, ops, members, cases, x0, result))
+            integrate.METHODS[config.method], physics.make_operators(n),
+            [c["g0"] for c in cases], config.w, x0, config.t_end, config.step_options(),
+            cost=[api.stability_parameter(c["g0"], c["theta0_deg"]) for c in cases])
+        outputs.append((members, x0, result))
     wall = time.perf_counter() - start
-    total_rhs = sum(int(r[5][3][:, 2].sum()) for r in outputs) or 1
-    for n, ops, members, cases, x0, (y_final, t_final, status, counts, worst) in outputs:
-        for b, (case_id, case) in enumerate(zip(members, cases)):
-            problem = problems.make_loop_problem(n, case["g0"], config.w, ops)
-            x = y_final[b].reshape(3, 2 * n + 1)
-            if not np.all(np.isfinite(x)):
-                x = x0[b].reshape(3, 2 * n + 1)  # keep the row finite; status says why
-            u, multiplier = api._velocity_and_multiplier(problem, x)
-            inputs = dict(g0=case["g0"], theta0_deg=case["theta0_deg"], n=n, t_end=config.t_end,
-                          rtol=config.rtol, atol=config.atol, w=config.w,
-                          perturbation=case["perturbation"], seed=case["seed"])
-            summary = api.terminal_summary(
-                inputs, x, u, multiplier, status=integrate.STATUS_NAMES[int(status[b])],
-                t_final=float(t_final[b]), steps_accepted=int(counts[b, 0]),
-                steps_rejected=int(counts[b, 1]), rhs_evals=int(counts[b, 2]),
-                wall_s=wall * threads * counts[b, 2] / total_rhs,
-            )
-            aspect0 = api.diagnostics.aspect_ratio(x0[b].reshape(3, -1))
-            summary.update(
-                case_id=case_id, aspect_ratio_initial=aspect0, x_final=x.ravel().tolist(),
-                length_error_max=float(worst[b]),
-                stop_reason=integrate.STOP_REASONS[int(status[b])],
-                regime=classify(case["theta0_deg"], summary["theta_final_deg"], aspect0,
-                                summary["aspect_ratio"], int(status[b]) in integrate.SUCCESS,
-                                config.thresholds),
-            )
-            rows[case_id] = summary
-    ordered = [rows[i] for i in sorted(rows)]
-    return pa.Table.from_pylist(ordered, schema=RESULT_SCHEMA)
+    total_rhs = sum(int(result[3][:, 2].sum()) for _, _, result in outputs) or 1
+    rows = {}
+    for members, x0, (y_final, t_final, status, counts, worst) in outputs:
+        for b, case_id in enumerate(members):
+            shape = (3, x0.shape[1] // 3)
+            rows[case_id] = _result_row(
+                config, case_id, config.cases[case_id], x0[b].reshape(shape),
+                y_final[b].reshape(shape), int(status[b]), counts[b], worst[b],
+                wall * threads * counts[b, 2] / total_rhs, float(t_final[b]))
+    snapshots = []
+    for case_id in traced:
+        rows[case_id], table = _traced_case(config, case_id)
+        snapshots.append(table)
+    table = pa.Table.from_pylist([rows[i] for i in sorted(rows)], schema=RESULT_SCHEMA)
+    return table, (pa.concat_tables(snapshots) if snapshots else None)
+
+
+def read_snapshots(out):
+    """Trajectory snapshots of the cases chosen with ``snapshots_for`` (a DataFrame)."""
+    paths = sorted(glob.glob(os.path.join(out, "snapshots-*.parquet")))
+    if not paths:
+        return pd.DataFrame()
+    frame = pa.concat_tables([pq.read_table(p) for p in paths]).to_pandas()
+    return frame.sort_values(["case_id", "t"], kind="stable").reset_index(drop=True)
 
 
 class Progress:
@@ -310,7 +370,11 @@ def run_sweep(config, out, threads=None, quiet=False, command_line=None):
     for chunk in range(config.n_chunks):
         if chunk in done:
             continue
-        table = run_chunk(config, chunk, threads).replace_schema_metadata(metadata)
+        table, snapshots = run_chunk(config, chunk, threads)
+        table = table.replace_schema_metadata(metadata)
+        if snapshots is not None:  # written before the chunk: a finished chunk has its snapshots
+            io.write_table_atomically(snapshots.replace_schema_metadata(metadata),
+                                      os.path.join(out, SNAPSHOT_PATTERN.format(chunk)))
         io.write_table_atomically(table, os.path.join(out, CHUNK_PATTERN.format(chunk)))
         failures = sum(1 for s in table.column("status").to_pylist() if s != "ok")
         progress.update(table.num_rows, failures)

@@ -133,3 +133,26 @@ def test_resume_after_sigkill_equals_uninterrupted_run(tmp_path):
     assert list(resumed["case_id"]) == list(range(9))  # none missing, none duplicated
     pd.testing.assert_frame_equal(resumed[DETERMINISTIC], expected[DETERMINISTIC])
     assert not list(killed.glob(".tmp-*"))  # a chunk cut short by the kill is cleaned up
+
+
+def test_snapshots_for_selected_cases(tmp_path):
+    out = str(tmp_path / "snap")
+    frame = ensemble.run_sweep(small_config(snapshots_for=[1, 4], snapshot_count=6), out,
+                               quiet=True)
+    snaps = loopsim.read_snapshots(out)
+    assert sorted(snaps["case_id"].unique()) == [1, 4]
+    for case_id, rows in snaps.groupby("case_id"):
+        np.testing.assert_allclose(rows["t"], np.linspace(0, 0.5, 6))
+        final = frame.set_index("case_id").loc[case_id]
+        # the row and the trajectory come from the same run
+        assert rows["aspect_ratio"].iloc[-1] == final["aspect_ratio"]
+        assert list(rows["x"].iloc[-1]) == list(final["x_final"])
+        assert len(rows["x"].iloc[-1]) == 3 * (2 * final["n"] + 1)
+    assert loopsim.read_snapshots(str(tmp_path / "nothing")).empty
+
+
+def test_snapshots_for_unknown_case_is_refused(tmp_path, capsys):
+    code = main(["sweep", "--g0", "10", "--theta0", "30", "--snapshots-for", "5",
+                 "--out", str(tmp_path / "s")])
+    err = capsys.readouterr().err
+    assert code == 2 and "case 5" in err
