@@ -1,0 +1,98 @@
+"""Scaling in n: cost per RHS evaluation and per trajectory, where the time goes,
+and whether the step is limited by stiffness or accuracy.
+
+Usage: python scripts/scaling.py [--orders 4,6,8,10,12,16] [--t-end 0.5]
+
+For each n (in-plane case g0 = 60, θ0 = 30°):
+* µs per RHS evaluation, split into the three maps (``compose_maps``), the
+  least-squares tension solve and the rest (velocity synthesis), each timed
+  in its own compiled loop;
+* one trajectory over t_end: steps, mean step against the stiffness bound
+  3.7/λmax, λmax = 1.5 n²(n² − 1), and the share of wall time spent outside
+  RHS evaluations (the stepper);
+then power-law exponents fitted over the larger orders.
+"""
+import argparse
+import time
+
+import numba
+import numpy as np
+
+import loopsim
+from loopsim import initial, physics, problems
+
+
+@numba.njit(cache=True)
+def _time_maps(x, g0, w, ops, ws, repeats):
+    for _ in range(repeats):
+        physics.compose_maps(x, g0, w, ops, ws)
+
+
+@numba.njit(cache=True)
+def _time_solve(block, ws, repeats):
+    for _ in range(repeats):
+        ws.length_rate[:] = block
+        physics.least_squares_affine(ws.length_rate, ws.tension)
+
+
+@numba.njit(cache=True)
+def _time_copy(block, ws, repeats):
+    for _ in range(repeats):
+        ws.length_rate[:] = block
+
+
+@numba.njit(cache=True)
+def _time_rhs(x, g0, w, ops, ws, u, repeats):
+    for _ in range(repeats):
+        physics.loop_velocity(x, g0, w, ops, ws, u)
+
+
+def per_call(fn, args, repeats):
+    fn(*args, 1)
+    best = np.inf
+    for _ in range(3):
+        start = time.perf_counter()
+        fn(*args, repeats)
+        best = min(best, time.perf_counter() - start)
+    return 1e6 * best / repeats
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--orders", default="4,6,8,10,12,16")
+    parser.add_argument("--t-end", type=float, default=0.5)
+    args = parser.parse_args()
+    orders = [int(v) for v in args.orders.split(",")]
+    g0, w = 60.0, 10.0
+    rows = []
+    print(f"{'n':>3} {'us/rhs':>8} {'maps':>7} {'lstsq':>7} {'rest':>6} {'steps':>7} "
+          f"{'mean_h':>9} {'3.7/lmax':>9} {'traj_s':>8} {'stepper%':>8}")
+    for n in orders:
+        x = initial.initial_shape(n, np.radians(30.0), 1e-3, 0)
+        problem = problems.make_loop_problem(n, g0, w)
+        ops, ws = problem.ops, problem.ws
+        u = np.empty_like(x)
+        repeats = max(200, int(2e5 / n**3))
+        rhs = per_call(_time_rhs, (x, g0, w, ops, ws, u), repeats)
+        maps = per_call(_time_maps, (x, g0, w, ops, ws), repeats)
+        physics.compose_maps(x, g0, w, ops, ws)
+        block = ws.length_rate.copy()
+        solve = per_call(_time_solve, (block, ws), repeats) - per_call(_time_copy, (block, ws), repeats)
+        result = loopsim.simulate(g0, 30.0, n=n, t_span=(0, args.t_end))
+        stepper = 1 - result.rhs_evals * rhs * 1e-6 / result.wall_s
+        bound = 3.7 / (1.5 * n**2 * (n**2 - 1))
+        rows.append((n, rhs, result.wall_s * 10 / args.t_end))
+        print(f"{n:>3} {rhs:>8.2f} {maps:>7.2f} {solve:>7.2f} {rhs - maps - solve:>6.2f} "
+              f"{result.steps_accepted:>7} {result.t_final / result.steps_accepted:>9.2e} "
+              f"{bound:>9.2e} {result.wall_s:>8.3f} {100 * stepper:>7.0f}%", flush=True)
+    big = [r for r in rows if r[0] >= 8]
+    if len(big) >= 2:
+        logn = np.log([r[0] for r in big])
+        rhs_exp = np.polyfit(logn, np.log([r[1] for r in big]), 1)[0]
+        traj_exp = np.polyfit(logn, np.log([r[2] for r in big]), 1)[0]
+        print(f"# fitted over n >= 8: time per RHS ~ n^{rhs_exp:.2f}, "
+              f"time per unit simulated time ~ n^{traj_exp:.2f} (paper's crude estimate: n^7)")
+
+
+if __name__ == "__main__":
+    main()
