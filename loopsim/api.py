@@ -6,7 +6,8 @@ import time
 
 import numpy as np
 
-from . import diagnostics, initial, physics, problems
+from . import diagnostics, initial, physics, problems, shapes
+from . import initial as _initial_module  # ``initial`` is also simulate's keyword
 from . import integrate as _integrate
 from .config import (
     DEFAULT_ATOL, DEFAULT_LENGTH_TOL, DEFAULT_MAX_STEPS, DEFAULT_N,
@@ -69,6 +70,7 @@ class SimulationResult:
     rhs_evals: int
     wall_s: float
     length_error_max: float  # largest |relative length error| at accepted steps
+    initial_info: dict = None  # diagnostics of a given initial shape (``shapes``), else None
 
     @property
     def ok(self):
@@ -132,11 +134,12 @@ def _velocity_and_multiplier(problem, x):
 
 
 def simulate(
-    g0, theta0_deg, *, n=DEFAULT_N, t_span=(0.0, DEFAULT_T_END), t_eval=None,
+    g0, theta0_deg=None, *, n=None, t_span=(0.0, DEFAULT_T_END), t_eval=None,
     snapshots=2, rtol=DEFAULT_RTOL, atol=DEFAULT_ATOL, w=DEFAULT_W,
-    perturbation=DEFAULT_PERTURBATION, seed=DEFAULT_SEED, method="rkf45",
+    perturbation=None, seed=DEFAULT_SEED, method="rkf45",
     max_steps=DEFAULT_MAX_STEPS, length_tol=DEFAULT_LENGTH_TOL, first_step=None,
     max_step=math.inf, min_step=0.0, steady_tol=None, steady_interval=DEFAULT_STEADY_INTERVAL,
+    initial=None, initial_case_id=None,
 ):
     """Simulate a loop released as a perturbed circle tilted by ``theta0_deg``.
 
@@ -147,13 +150,35 @@ def simulate(
     stops early at a steady terminal state (``integrate.step_options``).
     ``g0`` is gravity over
     stiffness, ``w`` the length-penalty rate, ``perturbation`` the RMS size of
-    the seeded initial perturbation (``initial`` module).
+    the seeded initial perturbation (``initial`` module; default 1e-3, n = 6).
+
+    ``initial`` starts from a given shape instead of the tilted circle:
+    coefficients (3, 2m+1) or a path (point file or results, with
+    ``initial_case_id``; ``shapes.load_initial``).  n defaults to the shape's
+    order (6 for point files; coefficients are resized, exactly when n ≥ m);
+    ``theta0_deg`` must then be None and is recorded as the shape's measured
+    tilt; ``perturbation`` defaults to 0 (``shapes.perturb`` when > 0).
+    ``result.initial_info`` holds the shape's diagnostics (``shapes``).
 
     Never raises for a failed integration: see ``result.status``.
     """
     g0 = check_real("g0", g0, low=0.0)
-    theta0_deg = check_real("theta0_deg", theta0_deg, low=0.0, high=90.0)
-    n = check_integer("n", n, 1)
+    if n is not None:
+        n = check_integer("n", n, 1)
+    start, initial_info = None, None
+    if initial is None:
+        if theta0_deg is None:
+            raise ValueError("theta0_deg is required unless an initial shape is given")
+        theta0_deg = check_real("theta0_deg", theta0_deg, low=0.0, high=90.0)
+        n = DEFAULT_N if n is None else n
+        perturbation = DEFAULT_PERTURBATION if perturbation is None else perturbation
+    else:
+        if theta0_deg is not None:
+            raise ValueError(f"theta0_deg must be None with an initial shape (its tilt is "
+                             f"measured), got {theta0_deg!r}")
+        start, initial_info = shapes.resolve_initial(initial, n, initial_case_id)
+        n, theta0_deg = initial_info["n"], initial_info["tilt_deg"]
+        perturbation = 0.0 if perturbation is None else perturbation
     t0, t_end = (check_real("t_span[0]", t_span[0]), check_real("t_span[1]", t_span[1]))
     if not t_end > t0:
         raise ValueError(f"t_span must be increasing, got {tuple(t_span)!r}")
@@ -176,7 +201,10 @@ def simulate(
 
     inputs = dict(g0=g0, theta0_deg=theta0_deg, n=n, t_end=t_end, rtol=rtol, atol=atol,
                   w=w, perturbation=perturbation, seed=seed)
-    x0 = initial.initial_shape(n, math.radians(theta0_deg), perturbation, seed)
+    if start is None:
+        x0 = _initial_module.initial_shape(n, math.radians(theta0_deg), perturbation, seed)
+    else:
+        x0 = shapes.perturb(start, perturbation, seed)
     problem = problems.make_loop_problem(n, g0, w)
     y_out = np.full((t_eval.size, x0.size), np.nan)
     if first_step is not None:
@@ -209,4 +237,5 @@ def simulate(
         status=_integrate.STATUS_NAMES[status], status_code=int(status),
         t_final=float(t_final), steps_accepted=int(n_acc), steps_rejected=int(n_rej),
         rhs_evals=int(n_rhs), wall_s=wall, length_error_max=float(worst_length),
+        initial_info=initial_info,
     )

@@ -43,7 +43,8 @@ def _add_integration_options(parser):
     parser.add_argument("--atol", type=_real, default=DEFAULT_ATOL, help="absolute tolerance")
     parser.add_argument("--w", type=_real, default=DEFAULT_W, help="length-penalty rate")
     parser.add_argument("--perturbation", type=_real, default=DEFAULT_PERTURBATION, metavar="EPS",
-                        help="RMS size of the seeded initial perturbation (0: exact circle)")
+                        help="RMS size of the seeded initial perturbation (0: exact circle; "
+                        f"run: None = {DEFAULT_PERTURBATION:g}, or 0 with --initial)")
     parser.add_argument("--method", default="rkf45", help="time integrator")
 
 
@@ -67,12 +68,22 @@ def _build_parser():
         "(plus a seeded perturbation) and print its terminal summary.",
         formatter_class=argparse.ArgumentDefaultsHelpFormatter,
     )
-    run.add_argument("--g0", type=_real, required=True,
-                     help="gravity over bending stiffness, g0 = L^3 g rho_L / (8 pi^3 EI) >= 0")
-    run.add_argument("--theta0", type=_real, required=True, metavar="DEG",
-                     help="initial tilt of the loop's plane to the horizontal, in [0, 90] degrees")
-    run.add_argument("--n", type=int, default=DEFAULT_N, help="Fourier truncation order (>= 1)")
+    run.add_argument("--g0", type=_real,
+                     help="gravity over bending stiffness, g0 = L^3 g rho_L / (8 pi^3 EI) >= 0 "
+                     "(required, except when continuing from results: then their g0)")
+    run.add_argument("--theta0", type=_real, metavar="DEG",
+                     help="initial tilt of the loop's plane to the horizontal, in [0, 90] degrees "
+                     "(not with --initial: the tilt is measured)")
+    run.add_argument("--n", type=int, default=None,
+                     help=f"Fourier truncation order (>= 1; default {DEFAULT_N}, or the stored "
+                     "order of --initial results)")
+    run.add_argument("--initial", metavar="FILE|DIR",
+                     help="start from a shape: a CSV/Parquet point file (columns x, y, z, in "
+                     "order along the closed curve) or results (run --out file, sweep dir)")
+    run.add_argument("--case-id", type=int, default=None, metavar="K",
+                     help="with --initial results: the case whose terminal shape starts the run")
     _add_integration_options(run)
+    run.set_defaults(perturbation=None)
     run.add_argument("--seed", type=int, default=DEFAULT_SEED, help="perturbation seed (>= 0)")
     run.add_argument("--snapshots", type=int, default=2, metavar="K",
                      help="number of equally spaced snapshots stored, ends included")
@@ -93,7 +104,9 @@ def _build_parser():
     grid.add_argument("--n", default=str(DEFAULT_N), metavar="N[,N...]", help="truncation orders")
     grid.add_argument("--seeds", type=int, default=1, metavar="K", help="seeds 0..K-1 per point")
     grid.add_argument("--cases", metavar="FILE", help="CSV/Parquet with columns g0, theta0_deg "
-                      "[, n, seed, perturbation] instead of a grid")
+                      "[, n, seed, perturbation, initial, initial_case_id] instead of a grid "
+                      "(initial: a point file or results per row, paths relative to FILE; "
+                      "theta0_deg then left empty)")
     _add_integration_options(sweep)
     sweep.add_argument("--no-early-stop", action="store_true",
                        help="always integrate to --t-end (default: stop once the shape and tilt "
@@ -116,6 +129,26 @@ def _build_parser():
     )
     stability.add_argument("--n-max", type=int, default=60, help="largest truncation order")
     stability.add_argument("--json", action="store_true", help="print one JSON object")
+    full = stability.add_argument_group(
+        "full linearisation (--full): the Jacobian of loopsim's own right-hand side about "
+        "the translating circle, in-plane and out-of-plane sectors (docs/stability.md)")
+    full.add_argument("--full", action="store_true",
+                      help="critical q of both sectors at truncation --n (instead of the paper's table)")
+    full.add_argument("--n", type=int, default=16, help="truncation order of the full linearisation")
+    full.add_argument("--theta0", type=_real, default=90.0, metavar="DEG",
+                      help="tilt of the circle (the growth rates depend on q only)")
+    full.add_argument("--w", type=_real, default=DEFAULT_W, help="length-penalty rate")
+    full.add_argument("--q-scan", metavar="START:STOP:NUM|v1,v2,...",
+                      help="also the largest growth rate of each sector, the paper's and the "
+                      "corrected operator at these q")
+    full.add_argument("--g0", type=_real, metavar="G",
+                      help="also the spectrum at (G, --theta0): the --top largest eigenvalues "
+                      "with sector labels")
+    full.add_argument("--top", type=int, default=12, help="eigenvalues listed with --g0")
+    full.add_argument("--onset", type=_real, nargs=3, metavar=("EPS", "T_END", "DETECT"),
+                      help="also the q where a mode of size EPS reaches DETECT at T_END, per sector")
+    full.add_argument("--figure", metavar="PNG",
+                      help="draw growth rates vs q (paper's operator beside the full sectors)")
     return parser
 
 
@@ -128,18 +161,63 @@ def _format_summary(summary):
     return "\n".join(lines)
 
 
+def _load_initial_for_run(args):
+    """(start shape, info, g0) for ``run --initial``; one-line errors for bad combinations."""
+    from . import shapes
+
+    if args.theta0 is not None:
+        raise ValueError("give --theta0 or --initial, not both (the tilt of an --initial shape "
+                         "is measured from it)")
+    if args.n is not None and args.n < 1:
+        raise ValueError(f"n must be an integer >= 1, got {args.n}")
+    x, info = shapes.load_initial(args.initial, args.n, args.case_id)
+    g0 = args.g0 if args.g0 is not None else info.get("g0")
+    if g0 is None:
+        raise ValueError("--g0 is required (only results carry a g0 to continue with)")
+    return x, info, g0
+
+
+def _format_initial(info):
+    keys = ("kind", "source", "case_id", "points", "n", "length", "scale", "tilt_deg",
+            "aspect_ratio", "spectral_tail", "truncation", "t_final")
+    return "\n".join(["# initial shape"] + [
+        f"#   {k:<13}  {info[k]:.10g}" if isinstance(info[k], float) else f"#   {k:<13}  {info[k]}"
+        for k in keys if k in info])
+
+
 def _cmd_run(args):
     from . import api, io
 
+    g0, start, info = args.g0, None, None
+    if args.initial is not None:
+        start, info, g0 = _load_initial_for_run(args)
+    elif args.case_id is not None:
+        raise ValueError("--case-id needs --initial RESULTS")
+    elif args.theta0 is None or args.g0 is None:
+        raise ValueError(f"give {'--g0' if args.g0 is None else '--theta0'} (or --initial FILE)")
     result = api.simulate(
-        args.g0, args.theta0, n=args.n, t_span=(0.0, args.t_end), snapshots=args.snapshots,
+        g0, args.theta0, n=args.n, t_span=(0.0, args.t_end), snapshots=args.snapshots,
         rtol=args.rtol, atol=args.atol, w=args.w, perturbation=args.perturbation,
-        seed=args.seed, method=args.method,
+        seed=args.seed, method=args.method, initial=start,
     )
     summary = result.summary()
-    if args.out:
+    if info is not None:
+        info = dict(info, perturbation=summary["perturbation"])
+        result.initial_info = info
+        for warning in info["warnings"]:
+            print(f"loopsim: warning: {warning}", file=sys.stderr)
+    if args.out and info is None:
         io.write_trajectory(result, args.out, command_line=sys.argv)
-    print(json.dumps(summary) if args.json else _format_summary(summary))
+    elif args.out:  # the initial shape's diagnostics (scale, source) as metadata "initial"
+        table = io.trajectory_table(result, command_line=sys.argv)
+        meta = dict(table.schema.metadata or {})
+        meta[b"initial"] = json.dumps(info).encode()
+        io.write_table_atomically(table.replace_schema_metadata(meta), args.out)
+    if args.json:
+        print(json.dumps(summary if info is None else dict(summary, initial=info)))
+    else:
+        print(_format_summary(summary) if info is None
+              else _format_initial(info) + "\n" + _format_summary(summary))
     return 0 if result.ok else EXIT_FAILED_RUN
 
 
@@ -178,9 +256,79 @@ def _cmd_sweep(args):
     return 0
 
 
+def _cmd_stability_full(args):
+    from . import ensemble, full_stability, linear_stability
+
+    if args.n < 3:
+        raise ValueError(f"--n must be >= 3 for the full linearisation, got {args.n}")
+    if not 0.0 < args.theta0 <= 90.0:
+        raise ValueError(f"--theta0 must be in (0, 90], got {args.theta0}")
+    if args.w <= 0.0:
+        raise ValueError(f"--w must be > 0, got {args.w}")
+    nan_none = lambda v: None if math.isnan(v) else v  # noqa: E731
+    out = {
+        "operator": "full", "n": args.n, "theta0_deg": args.theta0, "w": args.w,
+        "q_crit_in_plane": nan_none(full_stability.critical_q(args.n, "in-plane", args.theta0, args.w)),
+        "q_crit_out_of_plane": nan_none(full_stability.critical_q(args.n, "out-of-plane", args.theta0,
+                                                                  args.w)),
+        "q_crit_paper": nan_none(linear_stability.critical_q(args.n)),
+        "q_crit_corrected_operator": nan_none(full_stability.corrected_critical_q(args.n)),
+    }
+    if args.q_scan:
+        out["q_scan"] = full_stability.paper_comparison(
+            ensemble.parse_values(args.q_scan, "--q-scan"), args.n, args.theta0, args.w)
+    if args.g0 is not None:
+        if args.g0 < 0.0:
+            raise ValueError(f"--g0 must be >= 0, got {args.g0}")
+        spec = full_stability.full_spectrum(args.g0, args.theta0, args.n, args.w)
+        top = (spec.sector != "neutral").nonzero()[0][:max(1, args.top)]
+        out["spectrum"] = {
+            "g0": args.g0, "q": spec.q, "neutral_modes": int((spec.sector == "neutral").sum()),
+            "growth_rate": {s: spec.growth_rate(s) for s in full_stability.SECTORS},
+            "eigenvalues_real": spec.eigenvalues.real[top].tolist(),
+            "eigenvalues_imag": spec.eigenvalues.imag[top].tolist(),
+            "sector": spec.sector[top].tolist(),
+            "out_of_plane_fraction": spec.out_of_plane_fraction[top].tolist(),
+        }
+    if args.onset:
+        eps, t_end, detect = args.onset
+        out["onset"] = {"eps": eps, "t_end": t_end, "detect": detect, **{
+            f"q_{s.replace('-', '_')}": nan_none(full_stability.onset_q(
+                eps, t_end, detect, args.n, s, args.theta0, args.w)) for s in full_stability.SECTORS}}
+    if args.figure:
+        full_stability.comparison_figure(args.figure, args.n, theta0_deg=args.theta0, w=args.w)
+        out["figure"] = args.figure
+    if args.json:
+        print(json.dumps(out))
+        return 0
+    print(f"# full linearisation about the translating circle, n = {args.n}, "
+          f"theta0 = {args.theta0} deg, w = {args.w}")
+    for key in ("q_crit_in_plane", "q_crit_out_of_plane", "q_crit_paper", "q_crit_corrected_operator"):
+        print(f"{key:<26}  {'no crossing' if out[key] is None else f'{out[key]:.11f}'}")
+    if "q_scan" in out:
+        print(f"{'q':>10}  {'in-plane':>12}  {'out-of-plane':>12}  {'corrected':>12}  {'paper':>12}")
+        for row in out["q_scan"]:
+            print(f"{row['q']:>10.5g}  {row['in_plane']:>12.6g}  {row['out_of_plane']:>12.6g}  "
+                  f"{row['corrected']:>12.6g}  {row['paper']:>12.6g}")
+    if "spectrum" in out:
+        sp = out["spectrum"]
+        print(f"# spectrum at g0 = {sp['g0']}, q = {sp['q']:.6g} (largest, "
+              f"{sp['neutral_modes']} neutral modes left out)")
+        for re, im, sec in zip(sp["eigenvalues_real"], sp["eigenvalues_imag"], sp["sector"]):
+            print(f"{re:>16.9g} {im:>+12.4g}i  {sec}")
+    if "onset" in out:
+        for key, value in out["onset"].items():
+            print(f"onset {key:<16}  {value}")
+    if args.figure:
+        print(f"figure: {args.figure}")
+    return 0
+
+
 def _cmd_stability(args):
     from . import linear_stability
 
+    if args.full:
+        return _cmd_stability_full(args)
     if args.n_max < 1:
         raise ValueError(f"--n-max must be >= 1, got {args.n_max}")
     table = linear_stability.critical_q_table(args.n_max)

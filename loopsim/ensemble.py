@@ -22,7 +22,7 @@ import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from . import api, batch, initial, integrate, io, problems, physics
+from . import api, batch, initial, integrate, io, problems, physics, shapes
 from .config import (
     DEFAULT_ATOL, DEFAULT_LENGTH_TOL, DEFAULT_MAX_STEPS, DEFAULT_PERTURBATION, DEFAULT_RTOL,
     DEFAULT_STEADY_INTERVAL, DEFAULT_STEADY_TOL, DEFAULT_T_END, DEFAULT_W,
@@ -156,13 +156,27 @@ def read_cases_file(path, perturbation=DEFAULT_PERTURBATION, n=6):
         frame = pd.read_parquet(path) if str(path).endswith(".parquet") else pd.read_csv(path)
     except Exception as exc:  # noqa: BLE001 - any reader failure is the same user error
         raise ValueError(f"cannot read cases file {path!r}: {exc}".splitlines()[0]) from None
-    missing = {"g0", "theta0_deg"} - set(frame.columns)
+    missing = {"g0"} | ({"theta0_deg"} if "initial" not in frame.columns else set())
+    missing -= set(frame.columns)
     if missing:
         raise ValueError(f"cases file {path!r} lacks column(s) {sorted(missing)}")
-    frame = frame.assign(**{k: v for k, v in
-                            dict(n=n, seed=0, perturbation=perturbation).items() if k not in frame})
-    return [dict(g0=float(r.g0), theta0_deg=float(r.theta0_deg), n=int(r.n), seed=int(r.seed),
-                 perturbation=float(r.perturbation)) for r in frame.itertuples()]
+    given = frame.notna() if "initial" in frame.columns else None  # per-cell: value given?
+    frame = frame.assign(**{k: v for k, v in dict(n=n, seed=0, perturbation=perturbation,
+                                                  theta0_deg=math.nan).items() if k not in frame})
+    cases = [dict(g0=float(r.g0), theta0_deg=float(r.theta0_deg), n=int(r.n), seed=int(r.seed),
+                  perturbation=float(r.perturbation)) for r in frame.itertuples()]
+    for i, case in enumerate(cases):  # optional column initial (file or results), initial_case_id
+        if given is not None and given["initial"].iloc[i] and str(frame["initial"].iloc[i]).strip():
+            case_id = frame["initial_case_id"].iloc[i] if "initial_case_id" in frame else None
+            try:
+                cases[i] = shapes.initial_case(
+                    case, str(frame["initial"].iloc[i]).strip(),
+                    None if case_id is None or pd.isna(case_id) else int(case_id),
+                    os.path.dirname(str(path)),
+                    "perturbation" in given and bool(given["perturbation"].iloc[i]))
+            except ValueError as exc:
+                raise ValueError(f"cases file row {i}: {exc}") from None
+    return cases
 
 
 def validate(config):
@@ -198,6 +212,8 @@ def chunk_case_ids(config, chunk):
 
 
 def _initial_shape(case):
+    if case.get("initial"):  # a case started from a file (cases column "initial")
+        return shapes.case_shape(case)
     return initial.initial_shape(case["n"], math.radians(case["theta0_deg"]),
                                  case["perturbation"], case["seed"])
 
@@ -231,8 +247,11 @@ def _traced_case(config, case_id):
     """A case with snapshots: its row and trajectory come from one ``api.simulate`` run,
     so they agree exactly (its steps land on the snapshot times)."""
     case = config.cases[case_id]
+    start = dict(initial=case["initial"], initial_case_id=case.get("initial_case_id")) \
+        if case.get("initial") else {}
     result = api.simulate(
-        case["g0"], case["theta0_deg"], n=case["n"], t_span=(0.0, config.t_end),
+        case["g0"], None if start else case["theta0_deg"], **start, n=case["n"],
+        t_span=(0.0, config.t_end),
         snapshots=config.snapshot_count, rtol=config.rtol, atol=config.atol, w=config.w,
         perturbation=case["perturbation"], seed=case["seed"], method=config.method,
         max_steps=config.max_steps, length_tol=config.length_tol,
