@@ -19,6 +19,7 @@ import collections
 import numba
 import numpy as np
 
+from . import radau
 from .config import JIT
 from .problems import constraint_error, rhs, steady_invariants
 
@@ -51,7 +52,8 @@ StepOptions = collections.namedtuple(
 
 # ---- methods ---------------------------------------------------------------
 RKF45 = 0
-METHODS = {"rkf45": RKF45}
+RADAU5 = 1
+METHODS = {"rkf45": RKF45, "radau5": RADAU5}
 
 # Runge–Kutta–Fehlberg 4(5): E. Fehlberg, NASA TR R-315 (1969), Table III.
 # We advance with the 5th-order weights (local extrapolation) and use the
@@ -202,6 +204,69 @@ def integrate(method, problem, y0, t0, t_end, t_out, options, y_out):
     max_constraint_error), the last the largest |constraint_error| seen at
     accepted steps (for a loop: the worst transient relative length error).
     """
+    if method == RADAU5:
+        return _integrate_radau(problem, y0, t0, t_end, t_out, options, y_out)
+    return _integrate_explicit(method, problem, y0, t0, t_end, t_out, options, y_out)
+
+
+@numba.njit(**JIT)
+def _record_start(problem, y, t0, t_out, y_out, options):
+    """Outputs at t0 and the initial monitor state (i_out, next_check, invariants, quiet)."""
+    i_out = 0
+    while i_out < t_out.shape[0] and t_out[i_out] <= t0:
+        y_out[i_out] = y
+        i_out += 1
+    return i_out, t0 + options.steady_interval, steady_invariants(problem, y), 0
+
+
+@numba.njit(**JIT)
+def _landing(t, h, t_end, t_out, i_out):
+    """Step to try from t: h, shortened to land exactly on the next output time or t_end
+    (or stretched by up to 1e-8 relative rather than leave a sliver).  Returns (h_try, clipped, t_stop)."""
+    t_stop = t_end
+    if i_out < t_out.shape[0] and t_out[i_out] < t_stop:
+        t_stop = t_out[i_out]
+    if t + h * (1.0 + 1e-8) >= t_stop:
+        return t_stop - t, True, t_stop
+    return h, False, t_stop
+
+
+@numba.njit(**JIT)
+def _monitor(problem, t, y, t_end, t_out, y_out, options, i_out, worst, next_check, previous,
+             quiet):
+    """After an accepted step: length error, outputs, steady state.
+
+    Returns (status or -1 to go on, i_out, worst, next_check, previous, quiet).
+    """
+    worst = max(worst, abs(constraint_error(problem, y)))
+    if worst > options.constraint_tol:
+        return LENGTH_ERROR, i_out, worst, next_check, previous, quiet
+    while i_out < t_out.shape[0] and t_out[i_out] <= t:
+        y_out[i_out] = y
+        i_out += 1
+    if options.steady_interval > 0.0 and t >= next_check and t < t_end:
+        current = steady_invariants(problem, y)
+        quiet = quiet + 1 if max_abs_difference(current, previous) <= options.steady_tol else 0
+        if quiet >= STEADY_WINDOWS:
+            return STEADY, i_out, worst, next_check, current, quiet
+        previous = current
+        next_check = t + options.steady_interval
+    return -1, i_out, worst, next_check, previous, quiet
+
+
+@numba.njit(**JIT)
+def _stop_check(options, n_steps, h, t, y):
+    """Status that ends the run before the next attempt, or -1."""
+    if n_steps >= options.max_steps:
+        return STEP_BUDGET
+    if h < max(options.min_step, 10.0 * np.finfo(np.float64).eps * abs(t)):
+        return STEP_UNDERFLOW if _all_finite(y) else NON_FINITE
+    return -1
+
+
+@numba.njit(**JIT)
+def _integrate_explicit(method, problem, y0, t0, t_end, t_out, options, y_out):
+    """Driver for the explicit embedded Runge–Kutta methods (see :func:`integrate`)."""
     rtol, atol = options.rtol, options.atol
     ny = y0.shape[0]
     y = y0.copy()
@@ -218,35 +283,17 @@ def integrate(method, problem, y0, t0, t_end, t_out, options, y_out):
     rhs(problem, y, k[0])
     if not _all_finite(k[0]) or not _all_finite(y):
         return NON_FINITE, t, y, n_acc, n_rej, n_rhs, worst
-    i_out = 0
-    while i_out < t_out.shape[0] and t_out[i_out] <= t0:
-        y_out[i_out] = y
-        i_out += 1
+    i_out, next_check, previous, quiet = _record_start(problem, y, t0, t_out, y_out, options)
     if options.first_step > 0.0:
         h = min(options.first_step, options.max_step)
     else:
         h = initial_step(problem, y, k[0], rtol, atol, order, options.max_step)
         n_rhs += 1
-    watch_steady = options.steady_interval > 0.0
-    next_check = t0 + options.steady_interval
-    previous = steady_invariants(problem, y)
-    quiet_windows = 0
     while t < t_end:
-        if n_acc + n_rej >= options.max_steps:
-            return STEP_BUDGET, t, y, n_acc, n_rej, n_rhs, worst
-        floor = max(options.min_step, 10.0 * np.finfo(np.float64).eps * abs(t))
-        if h < floor:
-            status = STEP_UNDERFLOW if _all_finite(y) else NON_FINITE
-            return status, t, y, n_acc, n_rej, n_rhs, worst
-        # land exactly on the next output time or on t_end
-        t_stop = t_end
-        if i_out < t_out.shape[0] and t_out[i_out] < t_stop:
-            t_stop = t_out[i_out]
-        h_try = h
-        # stretch by up to 1e-8 relative rather than leave a sliver of a step
-        clipped = t + h_try * (1.0 + 1e-8) >= t_stop
-        if clipped:
-            h_try = t_stop - t
+        stop = _stop_check(options, n_acc + n_rej, h, t, y)
+        if stop >= 0:
+            return stop, t, y, n_acc, n_rej, n_rhs, worst
+        h_try, clipped, t_stop = _landing(t, h, t_end, t_out, i_out)
         n_rhs += _attempt(method, problem, y, h_try, k, stage, y_new, err)
         err_norm = rms_error_norm(err, y, y_new, rtol, atol)
         if not (err_norm <= 1.0):  # also rejects NaN
@@ -260,23 +307,152 @@ def integrate(method, problem, y0, t0, t_end, t_out, options, y_out):
         n_rhs += 1
         if not _all_finite(k[0]):
             return NON_FINITE, t, y, n_acc, n_rej, n_rhs, worst
-        worst = max(worst, abs(constraint_error(problem, y)))
-        if worst > options.constraint_tol:
-            return LENGTH_ERROR, t, y, n_acc, n_rej, n_rhs, worst
-        while i_out < t_out.shape[0] and t_out[i_out] <= t:
-            y_out[i_out] = y
-            i_out += 1
-        if watch_steady and t >= next_check and t < t_end:
-            current = steady_invariants(problem, y)
-            quiet_windows = quiet_windows + 1 if max_abs_difference(current, previous) \
-                <= options.steady_tol else 0
-            if quiet_windows >= STEADY_WINDOWS:
-                return STEADY, t, y, n_acc, n_rej, n_rhs, worst
-            previous = current
-            next_check = t + options.steady_interval
+        stop, i_out, worst, next_check, previous, quiet = _monitor(
+            problem, t, y, t_end, t_out, y_out, options, i_out, worst, next_check, previous, quiet)
+        if stop >= 0:
+            return stop, t, y, n_acc, n_rej, n_rhs, worst
         # a step shortened to hit an output time says nothing about the next h
         factor = step_factor(err_norm, order)
         h = min(options.max_step, max(h, h_try * factor) if clipped else h_try * factor)
+    return OK, t, y, n_acc, n_rej, n_rhs, worst
+
+
+@numba.njit(**JIT)
+def _radau_factor(h, h_old, err_norm, err_old):
+    """Predictive (Gustafsson) step factor, as scipy's Radau; before the safety factor."""
+    multiplier = 1.0
+    if err_old > 0.0 and h_old > 0.0 and err_norm > 0.0:
+        multiplier = h / h_old * (err_old / err_norm) ** 0.25
+    if err_norm == 0.0:
+        return MAX_FACTOR
+    return min(1.0, multiplier) * err_norm ** -0.25
+
+
+@numba.njit(**JIT)
+def _integrate_radau(problem, y0, t0, t_end, t_out, options, y_out):
+    """Driver for Radau IIA (order 5) with simplified Newton (see ``radau``).
+
+    Jacobian and LU reuse follow scipy's Radau: the LU factors are kept
+    while h does not change (h is held unless it should grow by ≥ 1.2 or
+    shrink), the Jacobian is refreshed after a slowly converging Newton
+    iteration or when Newton fails with a stale one; a failed Newton halves h.
+    """
+    rtol, atol = options.rtol, options.atol
+    n = y0.shape[0]
+    y = y0.copy()
+    f = np.empty(n)
+    y_new = np.empty(n)
+    err = np.empty(n)
+    scale = np.empty(n)
+    work_y = np.empty(n)
+    work_f = np.empty(n)
+    real_rhs = np.empty(n)
+    complex_rhs = np.empty(n, dtype=np.complex128)
+    z = np.zeros((3, n))
+    w = np.empty((3, n))
+    fz = np.empty((3, n))
+    jac = np.empty((n, n))
+    lu_real = np.empty((n, n))
+    lu_complex = np.empty((n, n), dtype=np.complex128)
+    piv_real = np.empty(n, dtype=np.int64)
+    piv_complex = np.empty(n, dtype=np.int64)
+    n_acc = 0
+    n_rej = 0
+    worst = 0.0
+    t = t0
+    rhs(problem, y, f)
+    n_rhs = 1
+    if not _all_finite(f) or not _all_finite(y):
+        return NON_FINITE, t, y, n_acc, n_rej, n_rhs, worst
+    i_out, next_check, previous, quiet = _record_start(problem, y, t0, t_out, y_out, options)
+    radau.fd_jacobian(problem, y, f, jac, work_y, work_f)
+    n_rhs += n
+    jac_current = True
+    if options.first_step > 0.0:
+        h = min(options.first_step, options.max_step)
+    else:
+        h = initial_step(problem, y, f, rtol, atol, radau.ERROR_ORDER, options.max_step)
+        n_rhs += 1
+    newton_tol = max(10.0 * np.finfo(np.float64).eps / rtol, min(0.03, rtol ** 0.5))
+    h_lu = -1.0
+    h_old = -1.0
+    err_old = -1.0
+    rejected = False
+    while t < t_end:
+        stop = _stop_check(options, n_acc + n_rej, h, t, y)
+        if stop >= 0:
+            return stop, t, y, n_acc, n_rej, n_rhs, worst
+        h_try, clipped, t_stop = _landing(t, h, t_end, t_out, i_out)
+        for i in range(n):
+            scale[i] = atol + rtol * abs(y[i])
+        converged = False
+        iterations = 0
+        rate = -1.0
+        while True:
+            if h_try != h_lu:
+                radau.newton_matrices(jac, h_try, lu_real, piv_real, lu_complex, piv_complex)
+                h_lu = h_try
+            z[:] = 0.0
+            converged, iterations, rate = radau.solve_collocation(
+                problem, y, h_try, z, scale, newton_tol, lu_real, piv_real, lu_complex,
+                piv_complex, w, fz, work_y, real_rhs, complex_rhs)
+            n_rhs += 3 * iterations
+            if converged or jac_current:
+                break
+            radau.fd_jacobian(problem, y, f, jac, work_y, work_f)
+            n_rhs += n
+            jac_current = True
+            h_lu = -1.0
+        if not converged:
+            n_rej += 1
+            rejected = True
+            h = 0.5 * h_try
+            continue
+        for i in range(n):
+            y_new[i] = y[i] + z[2, i]
+            scale[i] = atol + rtol * max(abs(y[i]), abs(y_new[i]))
+        radau.error_estimate(f, z, h_try, lu_real, piv_real, err)
+        err_norm = radau._scaled_rms(err, scale)
+        if rejected and err_norm > 1.0:  # Hairer's second filtering after a rejection
+            for i in range(n):
+                work_y[i] = y[i] + err[i]
+            rhs(problem, work_y, work_f)
+            n_rhs += 1
+            radau.error_estimate(work_f, z, h_try, lu_real, piv_real, err)
+            err_norm = radau._scaled_rms(err, scale)
+        safety = 0.9 * (2 * radau.NEWTON_MAXITER + 1) / (2 * radau.NEWTON_MAXITER + iterations)
+        if not (err_norm <= 1.0):
+            n_rej += 1
+            rejected = True
+            h = h_try * max(MIN_FACTOR, safety * _radau_factor(h_try, h_old, err_norm, err_old))
+            continue
+        n_acc += 1
+        rejected = False
+        t = t_stop if clipped else t + h_try
+        y[:] = y_new
+        rhs(problem, y, f)
+        n_rhs += 1
+        if not _all_finite(f):
+            return NON_FINITE, t, y, n_acc, n_rej, n_rhs, worst
+        stop, i_out, worst, next_check, previous, quiet = _monitor(
+            problem, t, y, t_end, t_out, y_out, options, i_out, worst, next_check, previous, quiet)
+        if stop >= 0:
+            return stop, t, y, n_acc, n_rej, n_rhs, worst
+        recompute_jac = iterations > 2 and rate > 1e-3
+        factor = min(MAX_FACTOR, safety * _radau_factor(h_try, h_old, err_norm, err_old))
+        if not recompute_jac and factor < 1.2:
+            factor = 1.0  # keep h, and with it the LU factors
+        if recompute_jac:
+            radau.fd_jacobian(problem, y, f, jac, work_y, work_f)
+            n_rhs += n
+            jac_current = True
+            h_lu = -1.0
+        else:
+            jac_current = False
+        h_old = h_try
+        err_old = err_norm
+        proposal = h_try * factor
+        h = min(options.max_step, max(h, proposal) if clipped else proposal)
     return OK, t, y, n_acc, n_rej, n_rhs, worst
 
 
