@@ -349,6 +349,7 @@ def _integrate_radau(problem, y0, t0, t_end, t_out, options, y_out):
     real_rhs = np.empty(n)
     complex_rhs = np.empty(n, dtype=np.complex128)
     z = np.zeros((3, n))
+    poly = np.zeros((3, n))  # collocation polynomial of the last accepted step
     w = np.empty((3, n))
     fz = np.empty((3, n))
     jac = np.empty((n, n))
@@ -375,7 +376,7 @@ def _integrate_radau(problem, y0, t0, t_end, t_out, options, y_out):
         n_rhs += 1
     newton_tol = max(10.0 * np.finfo(np.float64).eps / rtol, min(0.03, rtol ** 0.5))
     h_lu = -1.0
-    h_old = -1.0
+    h_old = -1.0  # last accepted step (-1: none yet)
     err_old = -1.0
     rejected = False
     while t < t_end:
@@ -392,7 +393,10 @@ def _integrate_radau(problem, y0, t0, t_end, t_out, options, y_out):
             if h_try != h_lu:
                 radau.newton_matrices(jac, h_try, lu_real, piv_real, lu_complex, piv_complex)
                 h_lu = h_try
-            z[:] = 0.0
+            if h_old > 0.0:
+                radau.extrapolated_guess(poly, h_try / h_old, z)
+            else:
+                z[:] = 0.0
             converged, iterations, rate = radau.solve_collocation(
                 problem, y, h_try, z, scale, newton_tol, lu_real, piv_real, lu_complex,
                 piv_complex, w, fz, work_y, real_rhs, complex_rhs)
@@ -449,6 +453,7 @@ def _integrate_radau(problem, y0, t0, t_end, t_out, options, y_out):
             h_lu = -1.0
         else:
             jac_current = False
+        radau.collocation_polynomial(z, poly)
         h_old = h_try
         err_old = err_norm
         proposal = h_try * factor

@@ -60,6 +60,27 @@ def _embedded_weights(mu_real):
 
 T, TI, MU_REAL, MU_COMPLEX = _transformation()
 E = _embedded_weights(MU_REAL)
+#: Z_i = Σ_k q_k c_i^(k+1): the collocation polynomial's coefficients are q = V⁻¹ Z.
+VINV = np.linalg.inv(np.vander(C, 4, increasing=True)[:, 1:])
+
+
+@numba.njit(**JIT)
+def collocation_polynomial(z, q):
+    """q (3, n) with y(t_old + x h) = y_old + Σ_k q_k x^(k+1), from the stage increments z."""
+    for k in range(3):
+        for i in range(z.shape[1]):
+            q[k, i] = VINV[k, 0] * z[0, i] + VINV[k, 1] * z[1, i] + VINV[k, 2] * z[2, i]
+
+
+@numba.njit(**JIT)
+def extrapolated_guess(q, ratio, z):
+    """Newton start for the next step (h_new = ratio · h_old): the last step's collocation
+    polynomial evaluated at the new stage times, minus its end value."""
+    for r in range(3):
+        x = 1.0 + ratio * C[r]
+        for i in range(z.shape[1]):
+            z[r, i] = (q[0, i] * (x - 1.0) + q[1, i] * (x * x - 1.0)
+                       + q[2, i] * (x * x * x - 1.0))
 
 
 # ---- dense linear algebra (real and complex, same code) -------------------
