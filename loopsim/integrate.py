@@ -181,11 +181,13 @@ def step_options(rtol, atol, first_step=None, min_step=0.0, max_step=np.inf,
 
     first_step: None selects the starting step automatically.
     constraint_tol: stop with LENGTH_ERROR once |constraint_error| exceeds it.
-    steady_interval, steady_tol: every ``steady_interval`` time units compare
-    the problem's invariants (``problems.steady_invariants``) with their
-    values one interval earlier; when no invariant moved by more than
-    ``steady_tol`` over STEADY_WINDOWS consecutive intervals, stop with status
-    STEADY.  steady_interval <= 0 disables the check.
+    steady_interval, steady_tol: at the first accepted step at least
+    ``steady_interval`` after the previous check, compare the problem's
+    invariants (``problems.steady_invariants``) with their values there; when
+    no invariant changed by more than ``steady_tol`` per ``steady_interval``
+    (the change is scaled by steady_interval / elapsed time, so long implicit
+    steps are judged like short ones) at STEADY_WINDOWS consecutive checks,
+    stop with status STEADY.  steady_interval <= 0 disables the check.
     """
     return StepOptions(float(rtol), float(atol), -1.0 if first_step is None else float(first_step),
                        float(min_step), float(max_step), int(max_steps), float(constraint_tol),
@@ -246,7 +248,10 @@ def _monitor(problem, t, y, t_end, t_out, y_out, options, i_out, worst, next_che
         i_out += 1
     if options.steady_interval > 0.0 and t >= next_check and t < t_end:
         current = steady_invariants(problem, y)
-        quiet = quiet + 1 if max_abs_difference(current, previous) <= options.steady_tol else 0
+        # change per steady_interval, whatever the steps' length since the last check
+        elapsed = t - (next_check - options.steady_interval)
+        change = max_abs_difference(current, previous) * options.steady_interval / elapsed
+        quiet = quiet + 1 if change <= options.steady_tol else 0
         if quiet >= STEADY_WINDOWS:
             return STEADY, i_out, worst, next_check, current, quiet
         previous = current
