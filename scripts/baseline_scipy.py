@@ -12,8 +12,8 @@ measure come from loopsim so both start from the same state.
 
 Prints, in one run, wall time and terminal-shape error (max coefficient
 difference from a loopsim rtol = 1e-12 reference at the same n) for the
-baseline at several tolerances and for loopsim's RKF45, and the ratio at
-matched error.
+baseline at several tolerances and for loopsim's integrators, and the ratios
+at matched error.
 """
 import argparse
 import time
@@ -75,11 +75,15 @@ def main():
     parser.add_argument("--g0", type=float, default=60.0)
     parser.add_argument("--theta0", type=float, default=30.0)
     parser.add_argument("--t-end", type=float, default=10.0)
+    parser.add_argument("--methods", default="rkf45,radau5", help="loopsim integrators to time")
+    parser.add_argument("--reference-method", default="radau5",
+                        help="integrator of the rtol = 1e-12 reference")
     args = parser.parse_args()
     n = args.n
     run = dict(n=n, t_span=(0, args.t_end))
     loopsim.simulate(args.g0, args.theta0, n=n, t_span=(0, 0.01))  # JIT warm-up
-    reference = loopsim.simulate(args.g0, args.theta0, rtol=1e-12, atol=1e-14, **run).x_final
+    reference = loopsim.simulate(args.g0, args.theta0, rtol=1e-12, atol=1e-14,
+                                 method=args.reference_method, **run).x_final
     x0 = initial.initial_shape(n, np.radians(args.theta0), 1e-3, 0)
     rhs = NumpyLoop(n, args.g0, loopsim.config.DEFAULT_W)
     u_check = rhs(0.0, x0.ravel()).reshape(3, -1)
@@ -98,20 +102,26 @@ def main():
             results.append((f"scipy {method}", rtol, wall, error))
             print(f"{'scipy ' + method:>22} {rtol:>7.0e} {wall:>8.2f} {sol.nfev:>9} {error:>8.1e}",
                   flush=True)
-    for rtol in (1e-4, 1e-6, 1e-8):
-        result = loopsim.simulate(args.g0, args.theta0, rtol=rtol, atol=rtol * 1e-3, **run)
-        error = np.abs(result.x_final - reference).max()
-        results.append(("loopsim rkf45", rtol, result.wall_s, error))
-        print(f"{'loopsim rkf45':>22} {rtol:>7.0e} {result.wall_s:>8.2f} {result.rhs_evals:>9} "
-              f"{error:>8.1e}", flush=True)
-    ours = [r for r in results if r[0].startswith("loopsim")]
+    for method in args.methods.split(","):
+        for rtol in (1e-4, 1e-6, 1e-8):
+            result = loopsim.simulate(args.g0, args.theta0, rtol=rtol, atol=rtol * 1e-3,
+                                      method=method, **run)
+            error = np.abs(result.x_final - reference).max()
+            label = f"loopsim {method}"
+            results.append((label, rtol, result.wall_s, error))
+            print(f"{label:>22} {rtol:>7.0e} {result.wall_s:>8.3f} {result.rhs_evals:>9} "
+                  f"{error:>8.1e}", flush=True)
     for target in (1e-4, 1e-6):
         base = [r for r in results if r[0].startswith("scipy") and r[3] <= target]
-        mine = [r for r in ours if r[3] <= target]
-        if base and mine:
-            b, m = min(base, key=lambda r: r[2]), min(mine, key=lambda r: r[2])
-            print(f"# error <= {target:.0e}: fastest baseline {b[0]} {b[2]:.2f} s, "
-                  f"loopsim {m[2]:.3f} s: {b[2] / m[2]:.1f}x")
+        if not base:
+            continue
+        b = min(base, key=lambda r: r[2])
+        for method in args.methods.split(","):
+            mine = [r for r in results if r[0] == f"loopsim {method}" and r[3] <= target]
+            if mine:
+                m = min(mine, key=lambda r: r[2])
+                print(f"# error <= {target:.0e}: fastest baseline {b[0]} {b[2]:.2f} s, "
+                      f"loopsim {method} {m[2]:.3f} s: {b[2] / m[2]:.1f}x")
 
 
 if __name__ == "__main__":

@@ -33,18 +33,20 @@ def main():
     parser.add_argument("--theta0", default="6:90:8")
     parser.add_argument("--n", type=int, default=6)
     parser.add_argument("--t-end", type=float, default=10.0)
+    parser.add_argument("--method", default="rkf45", help="integrator")
     args = parser.parse_args()
     cases = ensemble.grid_cases(ensemble.parse_values(args.g0, "--g0"),
                                 ensemble.parse_values(args.theta0, "--theta0"), [args.n], 1)
-    warm = ensemble.SweepConfig(cases=cases[:2], t_end=0.01)
+    warm = ensemble.SweepConfig(cases=cases[:2], t_end=0.01, method=args.method)
     timed_sweep(warm, 2)  # compile
 
-    print(f"# {len(cases)} cases, n = {args.n}, t_end = {args.t_end}, "
+    print(f"# {args.method}: {len(cases)} cases, n = {args.n}, t_end = {args.t_end}, "
           f"{numba.config.NUMBA_NUM_THREADS} cores available")
     print(f"{'threads':>7} {'early_stop':>10} {'wall_s':>8} {'cases/s':>8}")
     results = {}
     for early in (False, True):
-        config = ensemble.SweepConfig(cases=cases, t_end=args.t_end, early_stop=early)
+        config = ensemble.SweepConfig(cases=cases, t_end=args.t_end, early_stop=early,
+                                      method=args.method)
         for threads in (1, 2):
             wall, frame = timed_sweep(config, threads)
             results[threads, early] = (wall, frame)
@@ -71,12 +73,13 @@ def main():
                                          c["seed"]).ravel() for c in cases])
     g0 = [c["g0"] for c in cases]
     options = ensemble.SweepConfig(cases=cases, early_stop=False).step_options()
+    method_id = integrate.METHODS[args.method]
     numba.set_num_threads(2)
     q0 = [c["g0"] * math.sin(math.radians(c["theta0_deg"])) / 3 for c in cases]
     walls = {}
     for label, cost in (("grid order", None), ("by q0", q0)):
         start = time.perf_counter()
-        batch.integrate_cases(integrate.RKF45, ops, g0, 10.0, x0, 3.0, options, cost=cost)
+        batch.integrate_cases(method_id, ops, g0, 10.0, x0, 3.0, options, cost=cost)
         walls[label] = time.perf_counter() - start
     print(f"# load balance, 2 threads, one batch, t_end = 3: lanes in grid order "
           f"{walls['grid order']:.1f} s, by decreasing q0 {walls['by q0']:.1f} s "
