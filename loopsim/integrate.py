@@ -447,7 +447,7 @@ def _integrate_radau(problem, y0, t0, t_end, t_out, options, y_out):
             problem, t, y, t_end, t_out, y_out, options, i_out, worst, next_check, previous, quiet)
         if stop >= 0:
             return stop, t, y, n_acc, n_rej, n_rhs, worst
-        recompute_jac = iterations > 2 and rate > 1e-3
+        recompute_jac = iterations > radau.JACOBIAN_ITERATIONS and rate > radau.JACOBIAN_RATE
         factor = min(MAX_FACTOR, safety * _radau_factor(h_try, h_old, err_norm, err_old))
         if not recompute_jac and factor < 1.2:
             factor = 1.0  # keep h, and with it the LU factors

@@ -32,6 +32,10 @@ A = np.array([
 ])
 ERROR_ORDER = 3  # the embedded estimate is O(h^4): factor err^(-1/4)
 NEWTON_MAXITER = 6
+#: Refresh the Jacobian after an accepted step whose Newton iteration took more
+#: than JACOBIAN_ITERATIONS iterations at a contraction rate above JACOBIAN_RATE.
+JACOBIAN_ITERATIONS = 2
+JACOBIAN_RATE = 1e-3
 
 
 def _transformation():
