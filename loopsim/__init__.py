@@ -7,6 +7,10 @@ operator), ``api`` (Python entry points), ``io`` (Parquet), ``cli``.
 """
 __version__ = "0.1.0"
 
+from . import _jitcache
+
+_jitcache.configure()  # before any kernel is decorated: see loopsim/_jitcache.py
+
 from .api import SUMMARY_FIELDS, SimulationResult, evaluate_maps, simulate, stability_parameter
 from .ensemble import read_results, read_snapshots
 
