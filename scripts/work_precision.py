@@ -12,7 +12,10 @@ Two cases:
 Two errors, kept apart:
 * time discretisation: the same n against an rtol = 1e-12 Radau run (max
   coefficient difference, same initial shape, so no symmetry to remove);
-* truncation: against the highest n run at rtol = 1e-12, compared modulo
+* truncation: against the highest n run at rtol = 1e-12 (caveat: the seeded
+  perturbation is normalised over modes 2..n, so these runs start from
+  slightly different curves, and terminal shapes depend on the start; see
+  tests/test_convergence.py for a clean convergence study), compared modulo
   the exact symmetries (rotation about the vertical, shift of arc length)
   through invariants: the amplitudes |mode k| = (Σ_c a_ck² + b_ck²)^½ for
   k = 1..4, the aspect ratio and the tilt.
