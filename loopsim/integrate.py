@@ -21,7 +21,7 @@ import numpy as np
 
 from . import radau
 from .config import JIT
-from .problems import constraint_error, rhs, steady_invariants
+from .problems import constraint_error, jacobian, rhs, steady_invariants
 
 # ---- status codes --------------------------------------------------------
 OK = 0
@@ -371,8 +371,7 @@ def _integrate_radau(problem, y0, t0, t_end, t_out, options, y_out):
     if not _all_finite(f) or not _all_finite(y):
         return NON_FINITE, t, y, n_acc, n_rej, n_rhs, worst
     i_out, next_check, previous, quiet = _record_start(problem, y, t0, t_out, y_out, options)
-    radau.fd_jacobian(problem, y, f, jac, work_y, work_f)
-    n_rhs += n
+    n_rhs += jacobian(problem, y, f, jac, work_y, work_f)
     jac_current = True
     if options.first_step > 0.0:
         h = min(options.first_step, options.max_step)
@@ -408,8 +407,7 @@ def _integrate_radau(problem, y0, t0, t_end, t_out, options, y_out):
             n_rhs += 3 * iterations
             if converged or jac_current:
                 break
-            radau.fd_jacobian(problem, y, f, jac, work_y, work_f)
-            n_rhs += n
+            n_rhs += jacobian(problem, y, f, jac, work_y, work_f)
             jac_current = True
             h_lu = -1.0
         if not converged:
@@ -452,8 +450,7 @@ def _integrate_radau(problem, y0, t0, t_end, t_out, options, y_out):
         if not recompute_jac and factor < 1.2:
             factor = 1.0  # keep h, and with it the LU factors
         if recompute_jac:
-            radau.fd_jacobian(problem, y, f, jac, work_y, work_f)
-            n_rhs += n
+            n_rhs += jacobian(problem, y, f, jac, work_y, work_f)
             jac_current = True
             h_lu = -1.0
         else:

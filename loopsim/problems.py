@@ -6,6 +6,9 @@ overload``), so the drivers stay generic and every specialisation is cached.
 
 * :class:`LoopProblem`: the sedimenting loop, state y = x.ravel() with x the
   (3, 2n+1) position coefficients (``spectral`` layout); dy/dt = u.
+Each problem type also provides its exact Jacobian (:func:`jacobian`), used
+by the implicit integrator.
+
 * :class:`RiccatiProblem`: y_i' = a_i y_i², exact solution
   y_i(t) = y_i(0) / (1 - a_i y_i(0) t); a nonlinear closed form used to
   verify the order of the integrators.
@@ -36,6 +39,11 @@ def rhs(problem, y, dydt):
 
 def constraint_error(problem, y):
     """The invariant the driver monitors (relative length error for a loop)."""
+    raise NotImplementedError("only callable from jitted code")
+
+
+def jacobian(problem, y, f, jac, work_y, work_f):
+    """jac = ∂F/∂y at y (f = F(y) given); returns the RHS evaluations it cost."""
     raise NotImplementedError("only callable from jitted code")
 
 
@@ -103,3 +111,21 @@ def _steady_invariants(problem, y):
         def riccati_invariants(problem, y):
             return y.copy()
         return riccati_invariants
+
+
+@overload(jacobian, jit_options=JIT)
+def _jacobian(problem, y, f, jac, work_y, work_f):
+    if _is(problem, LoopProblem):
+        def loop_jacobian(problem, y, f, jac, work_y, work_f):
+            k = y.shape[0] // 3
+            physics.loop_jacobian(y.reshape((3, k)), problem.g0, problem.w, problem.ops,
+                                  problem.ws, jac)
+            return 1  # one velocity evaluation inside
+        return loop_jacobian
+    if _is(problem, RiccatiProblem):
+        def riccati_jacobian(problem, y, f, jac, work_y, work_f):
+            jac[:] = 0.0
+            for i in range(y.shape[0]):
+                jac[i, i] = 2.0 * problem.rates[i] * y[i]
+            return 0
+        return riccati_jacobian

@@ -13,9 +13,11 @@ reused while h and J stay.  The embedded error estimate is Hairer's
 transformation T and the error weights are computed here from A, not typed
 in, and are tested as data.
 
-J is a forward-difference Jacobian of ``problems.rhs`` (one RHS evaluation
-per state component), refreshed only when Newton converges slowly, as in
-scipy's Radau.  Everything writes into caller-owned arrays.
+J comes from ``problems.jacobian`` (exact for every problem type; for the
+loop it is ``physics.loop_jacobian``), refreshed only when Newton converges
+slowly, as in scipy's Radau.  :func:`fd_jacobian` is kept as a
+forward-difference fallback for new problem types.  Everything writes into
+caller-owned arrays.
 """
 import numpy as np
 import numba

@@ -108,3 +108,27 @@ def test_outputs_real_and_finite(rng):
         z = naive.real_to_complex(field)
         n = (z.shape[-1] - 1) // 2
         np.testing.assert_allclose(z[..., :n], np.conj(z[..., n + 1 :][..., ::-1]))
+
+
+@pytest.mark.parametrize("n", [3, 6, 12])
+def test_exact_jacobian_against_finite_differences_and_numpy_twin(n, rng):
+    """physics.loop_jacobian (njit) against central differences of loop_velocity and
+    against the independent NumPy chain rule in full_stability.rhs_jacobian."""
+    from loopsim import full_stability
+
+    x = naive.random_shape(rng, n, amplitude=0.1)
+    problem = problems.make_loop_problem(n, 70.0, 10.0)
+    jac = np.empty((x.size, x.size))
+    physics.loop_jacobian(x, 70.0, 10.0, problem.ops, problem.ws, jac)
+    scale = np.abs(jac).max()
+    np.testing.assert_allclose(jac, full_stability.rhs_jacobian(x, 70.0, 10.0), atol=1e-12 * scale)
+    h = 1e-6
+    up, um = np.empty_like(x), np.empty_like(x)
+    fd = np.empty_like(jac)
+    for col in range(x.size):
+        step = np.zeros(x.size)
+        step[col] = h
+        physics.loop_velocity(x + step.reshape(x.shape), 70.0, 10.0, problem.ops, problem.ws, up)
+        physics.loop_velocity(x - step.reshape(x.shape), 70.0, 10.0, problem.ops, problem.ws, um)
+        fd[:, col] = ((up - um) / (2 * h)).ravel()
+    assert np.abs(jac - fd).max() < 1e-6 * scale  # central differences: O(h²) + round-off
