@@ -78,6 +78,8 @@ def main():
     parser.add_argument("--theta0", type=float, default=30.0)
     parser.add_argument("--t-end", type=float, default=10.0)
     parser.add_argument("--methods", default="rkf45,radau5", help="loopsim integrators to time")
+    parser.add_argument("--baselines", default="radau,bdf,radau-exact",
+                        help="scipy variants: radau, bdf (finite-difference Jacobian), radau-exact")
     parser.add_argument("--reference-method", default="radau5",
                         help="integrator of the rtol = 1e-12 reference")
     args = parser.parse_args()
@@ -97,8 +99,8 @@ def main():
     def exact_jacobian(t, y):  # the chain-rule Jacobian, plain NumPy (loopsim.full_stability)
         return full_stability.rhs_jacobian(y.reshape(3, -1), args.g0)
 
-    variants = (("Radau", None), ("BDF", None), ("Radau", exact_jacobian))
-    for method, jac in variants:
+    variants = {"radau": ("Radau", None), "bdf": ("BDF", None), "radau-exact": ("Radau", exact_jacobian)}
+    for method, jac in (variants[v] for v in args.baselines.split(",")):
         name = method + (" + exact J" if jac is not None else "")
         for rtol in (1e-4, 1e-6, 1e-8):
             start = time.perf_counter()
