@@ -1,18 +1,25 @@
 """loopsim: flexible elastic loops sedimenting in a viscous (Stokes) fluid.
 
-Layout: ``spectral`` (Fourier algebra), ``physics`` (the three maps and the
-tension solve, njit), ``problems`` and ``integrate`` (time stepping, njit),
-``initial`` and ``diagnostics`` (shapes), ``linear_stability`` (paper's
-operator), ``api`` (Python entry points), ``io`` (Parquet), ``cli``.
-"""
-__version__ = "0.1.0"
+Layout (each layer imports only those above it):
 
+* ``config``, ``validation``, ``spectral``, ``dispatch``: conventions, input
+  checks, Fourier algebra, generic functions for jitted code;
+* ``models``: equations of motion behind one interface (``local_sbt``: the loop);
+* ``integrators``: one adaptive driver, methods as data (RKF45, Radau IIA);
+* ``batch``: many cases in one parallel kernel;
+* ``diagnostics``, ``shapes``, ``stability``: shape measures, initial shapes,
+  linear stability of the circle;
+* ``io``: table schemas, Parquet writing and reading;
+* ``api`` (``simulate``), ``ensemble`` (sweeps), ``plots``, ``cli``.
+"""
 from . import _jitcache
+from ._version import __version__
 
 _jitcache.configure()  # before any kernel is decorated: see loopsim/_jitcache.py
 
-from .api import SUMMARY_FIELDS, SimulationResult, evaluate_maps, simulate, stability_parameter
-from .ensemble import read_results, read_snapshots
+from .api import SUMMARY_FIELDS, SimulationResult, evaluate_maps, simulate  # noqa: E402
+from .diagnostics import stability_parameter  # noqa: E402
+from .io import read_results, read_snapshots  # noqa: E402
 
 __all__ = ["simulate", "SimulationResult", "evaluate_maps", "stability_parameter",
            "SUMMARY_FIELDS", "read_results", "read_snapshots", "__version__"]

@@ -1,136 +1,137 @@
-"""The Python interface: validate, set up, call the compiled driver, summarise."""
+"""The Python interface: validate, set up, call the compiled driver, summarise.
+
+:func:`simulate` follows ``scipy.integrate.solve_ivp`` where the two overlap:
+the arguments ``t_span``, ``t_eval``, ``rtol``, ``atol``, ``method``,
+``first_step``, ``max_step``, ``min_step``, and the result's ``t``, ``y``,
+``success``, ``status``, ``message``, ``nfev``, ``njev``, ``nlu``.
+"""
 import dataclasses
 import math
-import numbers
 import time
 
 import numpy as np
 
-from . import diagnostics, initial, physics, problems, shapes
-from . import initial as _initial_module  # ``initial`` is also simulate's keyword
-from . import integrate as _integrate
+from . import diagnostics, integrators, io, models, shapes, validation
 from .config import (
-    DEFAULT_ATOL, DEFAULT_LENGTH_TOL, DEFAULT_MAX_STEPS, DEFAULT_N,
-    DEFAULT_PERTURBATION, DEFAULT_RTOL, DEFAULT_SEED, DEFAULT_STEADY_INTERVAL, DEFAULT_T_END,
-    DEFAULT_W,
+    DEFAULT_ATOL, DEFAULT_LENGTH_TOL, DEFAULT_MAX_STEPS, DEFAULT_RTOL, DEFAULT_SEED,
+    DEFAULT_STEADY_INTERVAL, DEFAULT_T_END, DEFAULT_W,
 )
+from .diagnostics import stability_parameter
 
-#: Summary fields, in order; they are also the ensemble table's columns.
-SUMMARY_FIELDS = (
-    "g0", "theta0_deg", "n", "q0", "t_end", "rtol", "atol", "w", "perturbation",
-    "seed", "status", "t_final", "steps_accepted", "steps_rejected", "rhs_evals",
-    "wall_s", "theta_final_deg", "q_final", "aspect_ratio", "axis_ratio", "u_x",
-    "u_y", "u_z", "settling_angle_deg", "tension_max", "tension_min",
-    "s_tension_max", "length_error",
-)
+SUMMARY_FIELDS = io.SUMMARY_FIELDS
+#: solve_ivp's status: -1 the integration failed, 0 it reached t_end, 1 it stopped
+#: early at a steady terminal state (a termination event).
+FAILED, REACHED_END, STOPPED_EARLY = -1, 0, 1
 
 
-def stability_parameter(g0, theta_deg):
-    """q = g0 sin θ / 3 (paper §4)."""
-    return g0 * math.sin(math.radians(theta_deg)) / 3.0
-
-
-# ---- input validation: one-line messages naming the value -----------------
-def check_real(name, value, low=-math.inf, high=math.inf, low_open=False):
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise ValueError(f"{name} must be a real number, got {value!r}")
-    value = float(value)
-    too_low = value <= low if low_open else value < low
-    if not math.isfinite(value) or too_low or value > high:
-        bound = "(" if low_open else "["
-        raise ValueError(f"{name} must be finite and in {bound}{low}, {high}], got {value!r}")
-    return value
-
-
-def check_integer(name, value, low):
-    if isinstance(value, bool) or not isinstance(value, numbers.Integral) or value < low:
-        raise ValueError(f"{name} must be an integer >= {low}, got {value!r}")
-    return int(value)
-
-
-@dataclasses.dataclass
+@dataclasses.dataclass(repr=False)
 class SimulationResult:
-    """One trajectory: inputs, snapshots, terminal diagnostics and run statistics.
+    """One trajectory: inputs, states at the requested times, the final state, statistics.
 
-    ``x[i]`` (3, 2n+1) are the position coefficients at ``t[i]`` and
+    ``t`` holds exactly the requested times that were reached (``t_missed`` the
+    others, after an early stop or a failure); ``x[i]`` (3, 2n+1) are the
+    position coefficients at ``t[i]``, ``u[i]`` the velocity and
     ``multiplier[i]`` (2n+1) the tension multiplier T there (``spectral``
-    layout); ``tension_profile(i)`` gives the physical axial force N(s).
+    layout); ``y`` is ``x`` flattened as solve_ivp's (n_state, n_times).  The
+    final state, at ``t_final``, is ``x_final``, ``u_final``,
+    ``multiplier_final``.  ``tension_profile(i)`` gives the physical axial
+    force N(s).
     """
 
     inputs: dict
+    method: str
     t: np.ndarray
     x: np.ndarray
     u: np.ndarray
     multiplier: np.ndarray
-    status: str
-    status_code: int
+    t_missed: np.ndarray
     t_final: float
+    x_final: np.ndarray
+    u_final: np.ndarray
+    multiplier_final: np.ndarray
+    status_code: int  # loopsim's detailed status (``integrators.STATUS_NAMES``)
     steps_accepted: int
     steps_rejected: int
-    rhs_evals: int
+    nfev: int
+    njev: int
+    nlu: int
     wall_s: float
     length_error_max: float  # largest |relative length error| at accepted steps
     initial_info: dict = None  # diagnostics of a given initial shape (``shapes``), else None
 
     @property
-    def ok(self):
-        return self.status_code in _integrate.SUCCESS
+    def success(self):
+        return self.status_code in integrators.SUCCESS
+
+    @property
+    def status(self):
+        """-1 failed, 0 reached t_end, 1 stopped early at a steady state (as solve_ivp)."""
+        if not self.success:
+            return FAILED
+        return STOPPED_EARLY if self.status_code == integrators.STEADY else REACHED_END
+
+    @property
+    def message(self):
+        return {REACHED_END: "reached t_end", STOPPED_EARLY: "stopped early: steady state"}.get(
+            self.status, integrators.STATUS_NAMES[self.status_code])
 
     @property
     def stop_reason(self):
         """'t_end', 'steady' (early stop at the terminal state) or the failure."""
-        return _integrate.STOP_REASONS[self.status_code]
+        return integrators.STOP_REASONS[self.status_code]
 
     @property
-    def x_final(self):
-        return self.x[-1]
+    def y(self):
+        return self.x.reshape(self.x.shape[0], -1).T
 
-    def tension_profile(self, i=-1):
-        """(s, N(s)) at snapshot i."""
+    def __repr__(self):
+        return (f"SimulationResult(g0={self.inputs['g0']:g}, theta0_deg="
+                f"{self.inputs['theta0_deg']:g}, n={self.inputs['n']}, method={self.method!r}, "
+                f"message={self.message!r}, t_final={self.t_final:g}, times={len(self.t)}, "
+                f"missed={len(self.t_missed)}, nfev={self.nfev}, njev={self.njev}, "
+                f"nlu={self.nlu}, wall_s={self.wall_s:.3g})")
+
+    def tension_profile(self, i=None):
+        """(s, N(s)) at requested time i, or at the final state (default)."""
+        if i is None:
+            return diagnostics.tension_profile(self.x_final, self.multiplier_final)
         return diagnostics.tension_profile(self.x[i], self.multiplier[i])
 
     def summary(self):
-        """Dict with exactly the keys of ``SUMMARY_FIELDS``."""
+        """Dict with exactly the keys of ``SUMMARY_FIELDS`` (the final state's diagnostics)."""
         return terminal_summary(
-            self.inputs, self.x[-1], self.u[-1], self.multiplier[-1], status=self.status,
-            t_final=self.t_final, steps_accepted=self.steps_accepted,
-            steps_rejected=self.steps_rejected, rhs_evals=self.rhs_evals, wall_s=self.wall_s,
-        )
+            self.inputs, self.x_final, self.u_final, self.multiplier_final,
+            status=integrators.STATUS_NAMES[self.status_code], t_final=self.t_final,
+            steps_accepted=self.steps_accepted, steps_rejected=self.steps_rejected,
+            nfev=self.nfev, njev=self.njev, nlu=self.nlu, wall_s=self.wall_s)
 
 
 def terminal_summary(inputs, x, u, multiplier, **run_stats):
     """Summary fields of a final shape x with velocity u and multiplier T.
 
     ``inputs``: g0, theta0_deg, n, t_end, rtol, atol, w, perturbation, seed;
-    ``run_stats``: status, t_final, steps_accepted, steps_rejected, rhs_evals, wall_s.
+    ``run_stats``: the ``io.RUN_FIELDS``.
     """
-    theta = diagnostics.tilt_deg(x)
-    t_max, t_min, s_max = diagnostics.tension_extremes(x, multiplier)
-    com_velocity = u[:, 0]
     values = dict(inputs, **run_stats)
-    values.update(
-        q0=stability_parameter(inputs["g0"], inputs["theta0_deg"]), theta_final_deg=theta,
-        q_final=stability_parameter(inputs["g0"], theta),
-        aspect_ratio=diagnostics.aspect_ratio(x), axis_ratio=diagnostics.axis_ratio(x),
-        u_x=float(com_velocity[0]), u_y=float(com_velocity[1]), u_z=float(com_velocity[2]),
-        settling_angle_deg=diagnostics.settling_angle_deg(com_velocity),
-        tension_max=t_max, tension_min=t_min, s_tension_max=s_max,
-        length_error=diagnostics.relative_length_error(x),
-    )
+    values["q0"] = stability_parameter(inputs["g0"], inputs["theta0_deg"])
+    values.update(diagnostics.evaluate(diagnostics.State(x, u, multiplier, inputs["g0"])))
     return {key: values[key] for key in SUMMARY_FIELDS}
 
 
 def evaluate_maps(x, g0, w=DEFAULT_W):
     """Velocity coefficients u (3, 2n+1) and multiplier T (2n+1) of shape x."""
     x = np.ascontiguousarray(x, dtype=float)
-    return _velocity_and_multiplier(problems.make_loop_problem((x.shape[-1] - 1) // 2, g0, w), x)
+    n = shapes.check_coefficients(x, "x")
+    return velocity_and_multiplier(models.local_sbt.make_problem(n, g0, w), x)
 
 
-def _velocity_and_multiplier(problem, x):
+def velocity_and_multiplier(problem, x):
+    """(u, T) of the loop problem at shape x (3, 2n+1)."""
     x = np.ascontiguousarray(x, dtype=float)
     u = np.empty_like(x)
-    physics.loop_velocity(x, problem.g0, problem.w, problem.ops, problem.ws, u)
-    return u, problem.ws.tension.copy()
+    multiplier = np.empty(x.shape[1])
+    models.evaluate(problem, x.ravel(), u.reshape(-1), multiplier)
+    return u, multiplier
 
 
 def simulate(
@@ -144,55 +145,44 @@ def simulate(
     """Simulate a loop released as a perturbed circle tilted by ``theta0_deg``.
 
     Parameters follow ``scipy.integrate.solve_ivp`` where they overlap:
-    ``t_span`` (t0, t_end), ``t_eval`` (output times; default ``snapshots``
-    equally spaced times including both ends), ``rtol``/``atol``, ``method``,
-    ``first_step``, ``max_step``, ``min_step``.  ``steady_tol`` (default off)
-    stops early at a steady terminal state (``integrate.step_options``).
-    ``g0`` is gravity over
-    stiffness, ``w`` the length-penalty rate, ``perturbation`` the RMS size of
-    the seeded initial perturbation (``initial`` module; default 1e-3, n = 6).
+    ``t_span`` (t0, t_end), ``t_eval`` (the output times, returned exactly;
+    default ``snapshots`` equally spaced times including both ends),
+    ``rtol``/``atol``, ``method`` (``integrators.METHODS``), ``first_step``,
+    ``max_step``, ``min_step``.  ``steady_tol`` (default off) stops early at a
+    steady terminal state (``integrators.step_options``).  ``g0`` is gravity
+    over stiffness, ``w`` the length-penalty rate, ``perturbation`` the RMS
+    size of the seeded initial perturbation (``shapes.circle``; default 1e-3,
+    n = 6).
 
     ``initial`` starts from a given shape instead of the tilted circle:
     coefficients (3, 2m+1) or a path (point file or results, with
-    ``initial_case_id``; ``shapes.load_initial``).  n defaults to the shape's
-    order (6 for point files; coefficients are resized, exactly when n ≥ m);
-    ``theta0_deg`` must then be None and is recorded as the shape's measured
-    tilt; ``perturbation`` defaults to 0 (``shapes.perturb`` when > 0).
-    ``result.initial_info`` holds the shape's diagnostics (``shapes``).
+    ``initial_case_id``); see ``shapes.start_shape`` for the defaults.
+    ``result.initial_info`` holds the shape's diagnostics.
 
-    Never raises for a failed integration: see ``result.status``.
+    Never raises for a failed integration: see ``result.success``.
     """
-    g0 = check_real("g0", g0, low=0.0)
-    if n is not None:
-        n = check_integer("n", n, 1)
-    start, initial_info = None, None
-    if initial is None:
-        if theta0_deg is None:
-            raise ValueError("theta0_deg is required unless an initial shape is given")
-        theta0_deg = check_real("theta0_deg", theta0_deg, low=0.0, high=90.0)
-        n = DEFAULT_N if n is None else n
-        perturbation = DEFAULT_PERTURBATION if perturbation is None else perturbation
-    else:
-        if theta0_deg is not None:
-            raise ValueError(f"theta0_deg must be None with an initial shape (its tilt is "
-                             f"measured), got {theta0_deg!r}")
-        start, initial_info = shapes.resolve_initial(initial, n, initial_case_id)
-        n, theta0_deg = initial_info["n"], initial_info["tilt_deg"]
-        perturbation = 0.0 if perturbation is None else perturbation
-    t0, t_end = (check_real("t_span[0]", t_span[0]), check_real("t_span[1]", t_span[1]))
+    g0 = validation.check_real("g0", g0, low=0.0)
+    method_object = integrators.METHODS[validation.check_choice("method", method,
+                                                                 integrators.METHODS)]
+    x0, theta0_deg, n, perturbation, initial_info = shapes.start_shape(
+        theta0_deg, n, perturbation, seed, initial, initial_case_id)
+    t0, t_end = (validation.check_real("t_span[0]", t_span[0]),
+                 validation.check_real("t_span[1]", t_span[1]))
     if not t_end > t0:
         raise ValueError(f"t_span must be increasing, got {tuple(t_span)!r}")
-    rtol = check_real("rtol", rtol, low=0.0, low_open=True)
-    atol = check_real("atol", atol, low=0.0)
-    w = check_real("w", w, low=0.0)
-    perturbation = check_real("perturbation", perturbation, low=0.0)
-    seed = check_integer("seed", seed, 0)
-    max_steps = check_integer("max_steps", max_steps, 1)
-    length_tol = check_real("length_tol", length_tol, low=0.0, low_open=True)
-    if method not in _integrate.METHODS:
-        raise ValueError(f"method must be one of {sorted(_integrate.METHODS)}, got {method!r}")
+    rtol = validation.check_real("rtol", rtol, low=0.0, low_open=True)
+    atol = validation.check_real("atol", atol, low=0.0)
+    w = validation.check_real("w", w, low=0.0)
+    max_steps = validation.check_integer("max_steps", max_steps, 1)
+    length_tol = validation.check_real("length_tol", length_tol, low=0.0, low_open=True)
+    if first_step is not None:
+        validation.check_real("first_step", first_step, 0.0, low_open=True)
+    steady_interval = validation.check_real("steady_interval", steady_interval, 0.0,
+                                            low_open=True)
+    if steady_tol is not None:
+        steady_tol = validation.check_real("steady_tol", steady_tol, 0.0, low_open=True)
     if t_eval is None:
-        snapshots = check_integer("snapshots", snapshots, 1)
+        snapshots = validation.check_integer("snapshots", snapshots, 1)
         t_eval = np.linspace(t0, t_end, snapshots) if snapshots > 1 else np.array([t_end])
     t_eval = np.asarray(t_eval, dtype=float)
     if t_eval.ndim != 1 or not np.all(np.isfinite(t_eval)) or np.any(np.diff(t_eval) <= 0) \
@@ -200,42 +190,28 @@ def simulate(
         raise ValueError("t_eval must be finite, strictly increasing and within t_span")
 
     inputs = dict(g0=g0, theta0_deg=theta0_deg, n=n, t_end=t_end, rtol=rtol, atol=atol,
-                  w=w, perturbation=perturbation, seed=seed)
-    if start is None:
-        x0 = _initial_module.initial_shape(n, math.radians(theta0_deg), perturbation, seed)
-    else:
-        x0 = shapes.perturb(start, perturbation, seed)
-    problem = problems.make_loop_problem(n, g0, w)
+                  w=w, perturbation=perturbation, seed=int(seed))
+    problem = models.local_sbt.make_problem(n, g0, w)
     y_out = np.full((t_eval.size, x0.size), np.nan)
-    if first_step is not None:
-        check_real("first_step", first_step, 0.0, low_open=True)
-    steady_interval = check_real("steady_interval", steady_interval, 0.0, low_open=True)
-    if steady_tol is not None:
-        steady_tol = check_real("steady_tol", steady_tol, 0.0, low_open=True)
-    options = _integrate.step_options(
+    options = integrators.step_options(
         rtol, atol, first_step, min_step, max_step, max_steps, length_tol,
         steady_interval if steady_tol is not None else 0.0, steady_tol or 0.0)
     start = time.perf_counter()
-    status, t_final, y_final, n_acc, n_rej, n_rhs, worst_length = _integrate.integrate(
-        _integrate.METHODS[method], problem, x0.ravel(), t0, t_end, t_eval, options, y_out,
-    )
+    status, t_final, y_final, counts, worst_length = integrators.integrate(
+        method_object, problem, x0.ravel(), t0, t_end, t_eval, options, y_out)
     wall = time.perf_counter() - start
 
     reached = t_eval <= t_final
-    times = t_eval[reached]
-    states = y_out[reached]
-    if times.size == 0 or times[-1] < t_final:  # always end on the final state
-        times = np.append(times, t_final)
-        states = np.vstack([states, y_final[None, :]])
-    x = states.reshape(-1, 3, x0.shape[1])
+    x = y_out[reached].reshape(-1, 3, x0.shape[1])
     u = np.empty_like(x)
     multiplier = np.empty((x.shape[0], x0.shape[1]))
     for i in range(x.shape[0]):
-        u[i], multiplier[i] = _velocity_and_multiplier(problem, x[i])
+        u[i], multiplier[i] = velocity_and_multiplier(problem, x[i])
+    x_final = y_final.reshape(3, -1)
+    u_final, multiplier_final = velocity_and_multiplier(problem, x_final)
+    stats = dict(zip(integrators.COUNTS, (int(c) for c in counts)))
     return SimulationResult(
-        inputs=inputs, t=times, x=x, u=u, multiplier=multiplier,
-        status=_integrate.STATUS_NAMES[status], status_code=int(status),
-        t_final=float(t_final), steps_accepted=int(n_acc), steps_rejected=int(n_rej),
-        rhs_evals=int(n_rhs), wall_s=wall, length_error_max=float(worst_length),
-        initial_info=initial_info,
-    )
+        inputs=inputs, method=method, t=t_eval[reached], x=x, u=u, multiplier=multiplier,
+        t_missed=t_eval[~reached], t_final=float(t_final), x_final=x_final, u_final=u_final,
+        multiplier_final=multiplier_final, status_code=int(status), wall_s=wall,
+        length_error_max=float(worst_length), initial_info=initial_info, **stats)

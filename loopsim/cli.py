@@ -1,4 +1,4 @@
-"""Command-line interface: ``loopsim run`` and ``loopsim stability``.
+"""Command-line interface: ``loopsim run``, ``loopsim sweep`` and ``loopsim stability``.
 
 Errors in the input end with one line ``loopsim: error: ...`` on stderr and
 exit status 2; a run that fails numerically exits 1 after printing its summary.
@@ -8,14 +8,26 @@ import json
 import math
 import sys
 
-from . import __version__
+from ._version import __version__
 from .config import (
     DEFAULT_ATOL, DEFAULT_N, DEFAULT_PERTURBATION, DEFAULT_RTOL, DEFAULT_SEED,
     DEFAULT_T_END, DEFAULT_W,
 )
 
+from .integrators import METHODS  # noqa: E402 - the names only; no kernel is compiled here
+
 EXIT_FAILED_RUN = 1
 EXIT_USAGE = 2
+
+
+class _HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
+    """Shows each option's default once: not for flags, None, or help that names its own."""
+
+    def _get_help_string(self, action):
+        text = action.help or ""
+        if "default" in text or action.default in (None, False, argparse.SUPPRESS):
+            return text
+        return super()._get_help_string(action)
 
 
 class _Parser(argparse.ArgumentParser):
@@ -44,8 +56,10 @@ def _add_integration_options(parser):
     parser.add_argument("--w", type=_real, default=DEFAULT_W, help="length-penalty rate")
     parser.add_argument("--perturbation", type=_real, default=DEFAULT_PERTURBATION, metavar="EPS",
                         help="RMS size of the seeded initial perturbation (0: exact circle; "
-                        f"run: None = {DEFAULT_PERTURBATION:g}, or 0 with --initial)")
-    parser.add_argument("--method", default="rkf45", help="time integrator")
+                        f"default {DEFAULT_PERTURBATION:g}, or 0 with --initial)")
+    parser.add_argument("--method", default="rkf45", choices=sorted(METHODS),
+                        help="time integrator: rkf45 (explicit, the paper's) or radau5 "
+                        "(implicit, for stiff stable and in-plane loops)")
 
 
 def _build_parser():
@@ -56,7 +70,8 @@ def _build_parser():
         epilog="Examples:\n  loopsim run --g0 60 --theta0 30\n"
         "  loopsim run --g0 150 --theta0 60 --n 8 --json\n"
         "  loopsim sweep --g0 10:350:8 --theta0 10:90:5 --out runs/phase --figure phase.png\n"
-        "  loopsim stability --n-max 20",
+        "  loopsim stability --n 16\n"
+        "  loopsim stability --paper --n-max 20",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("--version", action="version", version=f"loopsim {__version__}")
@@ -66,7 +81,7 @@ def _build_parser():
         "run", help="simulate one loop released as a tilted, perturbed circle",
         description="Simulate one loop released as a circle tilted by THETA0 degrees "
         "(plus a seeded perturbation) and print its terminal summary.",
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
+        formatter_class=_HelpFormatter,
     )
     run.add_argument("--g0", type=_real,
                      help="gravity over bending stiffness, g0 = L^3 g rho_L / (8 pi^3 EI) >= 0 "
@@ -96,7 +111,7 @@ def _build_parser():
         description="Integrate many loops in parallel and write one row per case into "
         "chunk files in DIR. Re-running the same command resumes; results are read with "
         "loopsim.read_results(DIR).",
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
+        formatter_class=_HelpFormatter,
     )
     grid = sweep.add_argument_group("cases (a grid, or --cases FILE)")
     grid.add_argument("--g0", metavar="START:STOP:NUM|v1,v2,...", help="g0 values")
@@ -122,33 +137,38 @@ def _build_parser():
     sweep.add_argument("--quiet", action="store_true", help="no progress line, only a summary")
 
     stability = commands.add_parser(
-        "stability", help="critical q of the paper's linear stability operator",
-        description="Critical stability parameter q = g0 sin(theta0)/3 of the paper's "
-        "truncated operator L (out-of-plane perturbations), for n = 1..N_MAX.",
-        formatter_class=argparse.ArgumentDefaultsHelpFormatter,
+        "stability", help="critical q of the translating circle (full linearisation)",
+        description="Critical stability parameter q = g0 sin(theta0)/3 of the translating "
+        "circle from the full linearisation of loopsim's own equations: the in-plane and "
+        "out-of-plane thresholds at truncation --n (docs/stability.md). --paper prints the "
+        "paper's operator instead (its q_c = 14.561 rests on a sign error).",
+        formatter_class=_HelpFormatter,
     )
-    stability.add_argument("--n-max", type=int, default=60, help="largest truncation order")
     stability.add_argument("--json", action="store_true", help="print one JSON object")
-    full = stability.add_argument_group(
-        "full linearisation (--full): the Jacobian of loopsim's own right-hand side about "
-        "the translating circle, in-plane and out-of-plane sectors (docs/stability.md)")
-    full.add_argument("--full", action="store_true",
-                      help="critical q of both sectors at truncation --n (instead of the paper's table)")
-    full.add_argument("--n", type=int, default=16, help="truncation order of the full linearisation")
-    full.add_argument("--theta0", type=_real, default=90.0, metavar="DEG",
-                      help="tilt of the circle (the growth rates depend on q only)")
-    full.add_argument("--w", type=_real, default=DEFAULT_W, help="length-penalty rate")
+    full = stability.add_argument_group("full linearisation (default)")
+    full.add_argument("--n", type=int, default=None,
+                      help="truncation order of the full linearisation (>= 3; default 16)")
+    full.add_argument("--theta0", type=_real, default=None, metavar="DEG",
+                      help="tilt of the circle in (0, 90] (default 90; the rates depend on q only)")
+    full.add_argument("--w", type=_real, default=None,
+                      help=f"length-penalty rate (default {DEFAULT_W:g})")
     full.add_argument("--q-scan", metavar="START:STOP:NUM|v1,v2,...",
                       help="also the largest growth rate of each sector, the paper's and the "
                       "corrected operator at these q")
     full.add_argument("--g0", type=_real, metavar="G",
                       help="also the spectrum at (G, --theta0): the --top largest eigenvalues "
                       "with sector labels")
-    full.add_argument("--top", type=int, default=12, help="eigenvalues listed with --g0")
+    full.add_argument("--top", type=int, default=None,
+                      help="eigenvalues listed with --g0 (default 12)")
     full.add_argument("--onset", type=_real, nargs=3, metavar=("EPS", "T_END", "DETECT"),
                       help="also the q where a mode of size EPS reaches DETECT at T_END, per sector")
     full.add_argument("--figure", metavar="PNG",
                       help="draw growth rates vs q (paper's operator beside the full sectors)")
+    paper_group = stability.add_argument_group("the paper's operator (--paper)")
+    paper_group.add_argument("--paper", action="store_true",
+                             help="the table of the paper's operator for n = 1..--n-max instead")
+    paper_group.add_argument("--n-max", type=int, default=None,
+                             help="largest truncation order of the --paper table (default 60)")
     return parser
 
 
@@ -218,11 +238,11 @@ def _cmd_run(args):
     else:
         print(_format_summary(summary) if info is None
               else _format_initial(info) + "\n" + _format_summary(summary))
-    return 0 if result.ok else EXIT_FAILED_RUN
+    return 0 if result.success else EXIT_FAILED_RUN
 
 
 def _cmd_sweep(args):
-    from . import ensemble, figures
+    from . import ensemble, plots
 
     if args.cases:
         if args.g0 or args.theta0:
@@ -251,14 +271,25 @@ def _cmd_sweep(args):
     counts = frame["regime"].value_counts().to_dict()
     print(f"{len(frame)} cases in {args.out}: " + ", ".join(f"{k} {v}" for k, v in sorted(counts.items())))
     if args.figure:
-        figures.phase_diagram(frame, args.figure)
+        _use_agg()
+        plots.save(plots.phase_diagram(frame), args.figure)
         print(f"phase diagram: {args.figure}")
     return 0
 
 
-def _cmd_stability_full(args):
-    from . import ensemble, full_stability, linear_stability
+FULL_DEFAULTS = dict(n=16, theta0=90.0, w=DEFAULT_W, top=12)
+FULL_ONLY = ("n", "theta0", "w", "q_scan", "g0", "top", "onset", "figure")
 
+
+def _cmd_stability_full(args):
+    from . import ensemble, plots
+    from .stability import circle, onset, paper
+
+    if args.n_max is not None:
+        raise ValueError("--n-max applies only to the --paper table")
+    for key, value in FULL_DEFAULTS.items():
+        if getattr(args, key) is None:
+            setattr(args, key, value)
     if args.n < 3:
         raise ValueError(f"--n must be >= 3 for the full linearisation, got {args.n}")
     if not 0.0 < args.theta0 <= 90.0:
@@ -268,23 +299,23 @@ def _cmd_stability_full(args):
     nan_none = lambda v: None if math.isnan(v) else v  # noqa: E731
     out = {
         "operator": "full", "n": args.n, "theta0_deg": args.theta0, "w": args.w,
-        "q_crit_in_plane": nan_none(full_stability.critical_q(args.n, "in-plane", args.theta0, args.w)),
-        "q_crit_out_of_plane": nan_none(full_stability.critical_q(args.n, "out-of-plane", args.theta0,
-                                                                  args.w)),
-        "q_crit_paper": nan_none(linear_stability.critical_q(args.n)),
-        "q_crit_corrected_operator": nan_none(full_stability.corrected_critical_q(args.n)),
+        "q_crit_in_plane": nan_none(circle.critical_q(args.n, "in-plane", args.theta0, args.w)),
+        "q_crit_out_of_plane": nan_none(circle.critical_q(args.n, "out-of-plane", args.theta0,
+                                                          args.w)),
+        "q_crit_paper": nan_none(paper.critical_q(args.n)),
+        "q_crit_corrected_operator": nan_none(paper.critical_q(args.n, corrected=True)),
     }
     if args.q_scan:
-        out["q_scan"] = full_stability.paper_comparison(
+        out["q_scan"] = circle.paper_comparison(
             ensemble.parse_values(args.q_scan, "--q-scan"), args.n, args.theta0, args.w)
     if args.g0 is not None:
         if args.g0 < 0.0:
             raise ValueError(f"--g0 must be >= 0, got {args.g0}")
-        spec = full_stability.full_spectrum(args.g0, args.theta0, args.n, args.w)
+        spec = circle.full_spectrum(args.g0, args.theta0, args.n, args.w)
         top = (spec.sector != "neutral").nonzero()[0][:max(1, args.top)]
         out["spectrum"] = {
             "g0": args.g0, "q": spec.q, "neutral_modes": int((spec.sector == "neutral").sum()),
-            "growth_rate": {s: spec.growth_rate(s) for s in full_stability.SECTORS},
+            "growth_rate": {s: spec.growth_rate(s) for s in circle.SECTORS},
             "eigenvalues_real": spec.eigenvalues.real[top].tolist(),
             "eigenvalues_imag": spec.eigenvalues.imag[top].tolist(),
             "sector": spec.sector[top].tolist(),
@@ -293,10 +324,11 @@ def _cmd_stability_full(args):
     if args.onset:
         eps, t_end, detect = args.onset
         out["onset"] = {"eps": eps, "t_end": t_end, "detect": detect, **{
-            f"q_{s.replace('-', '_')}": nan_none(full_stability.onset_q(
-                eps, t_end, detect, args.n, s, args.theta0, args.w)) for s in full_stability.SECTORS}}
+            f"q_{s.replace('-', '_')}": nan_none(onset.onset_q(
+                eps, t_end, detect, args.n, s, args.theta0, args.w)) for s in circle.SECTORS}}
     if args.figure:
-        full_stability.comparison_figure(args.figure, args.n, theta0_deg=args.theta0, w=args.w)
+        _use_agg()
+        plots.save(plots.growth_rates(args.n, theta0_deg=args.theta0, w=args.w), args.figure, dpi=120)
         out["figure"] = args.figure
     if args.json:
         print(json.dumps(out))
@@ -305,6 +337,7 @@ def _cmd_stability_full(args):
           f"theta0 = {args.theta0} deg, w = {args.w}")
     for key in ("q_crit_in_plane", "q_crit_out_of_plane", "q_crit_paper", "q_crit_corrected_operator"):
         print(f"{key:<26}  {'no crossing' if out[key] is None else f'{out[key]:.11f}'}")
+    print(f"# q_crit_paper: {paper.SIGN_NOTE}")
     if "q_scan" in out:
         print(f"{'q':>10}  {'in-plane':>12}  {'out-of-plane':>12}  {'corrected':>12}  {'paper':>12}")
         for row in out["q_scan"]:
@@ -325,22 +358,35 @@ def _cmd_stability_full(args):
 
 
 def _cmd_stability(args):
-    from . import linear_stability
+    from .stability import paper
 
-    if args.full:
+    if not args.paper:
         return _cmd_stability_full(args)
-    if args.n_max < 1:
-        raise ValueError(f"--n-max must be >= 1, got {args.n_max}")
-    table = linear_stability.critical_q_table(args.n_max)
+    given = [key for key in FULL_ONLY if getattr(args, key) is not None]
+    if given:
+        raise ValueError(f"--{given[0].replace('_', '-')} applies only to the full linearisation "
+                         "(drop --paper)")
+    n_max = 60 if args.n_max is None else args.n_max
+    if n_max < 1:
+        raise ValueError(f"--n-max must be >= 1, got {n_max}")
+    table = paper.critical_q_table(n_max)
     if args.json:
-        print(json.dumps({"operator": "paper", "critical_q": {
+        print(json.dumps({"operator": "paper", "note": paper.SIGN_NOTE, "critical_q": {
             str(n): (None if math.isnan(q) else q) for n, q in table}}))
     else:
         print("# critical q of the paper's operator L on span{sin ks, k <= n}")
+        print(f"# note: {paper.SIGN_NOTE}")
         print(f"{'n':>3}  q_crit")
         for n, q in table:
             print(f"{n:>3}  {'no crossing' if math.isnan(q) else f'{q:.11f}'}")
     return 0
+
+
+def _use_agg():
+    """Figures from the command line are files: the non-interactive Agg backend."""
+    import matplotlib
+
+    matplotlib.use("Agg")
 
 
 def main(argv=None):

@@ -1,15 +1,55 @@
-"""Diagnostics of a loop shape (plain NumPy, outside the hot loop).
+"""Diagnostics of a loop shape (plain NumPy, outside the hot loop), and their registry.
 
-All functions take position coefficients x of shape (3, 2n+1) (``spectral``
-layout); angles are returned in degrees, as at the user interface.
+All shape functions take position coefficients x of shape (3, 2n+1)
+(``spectral`` layout); angles are returned in degrees, as at the user
+interface.  :data:`REGISTRY` lists the diagnostics of a state that feed the
+run summary, the sweep table's columns and the trajectory table; adding one
+there adds it to all three.
 """
+import collections
+import math
+
 import numpy as np
 
 from . import spectral
-from .initial import curve_length
 
 #: Fine grid points per unit of order for tension profiles and lengths.
 PROFILE_POINTS_PER_ORDER = 64
+
+
+def curve_length(x, points=None):
+    """L = ∫|x'| ds by the (spectrally accurate) periodic trapezoid rule."""
+    n = spectral.order_of(x.shape[-1])
+    m = points or PROFILE_POINTS_PER_ORDER * (n + 1)
+    dx = x @ spectral.synthesis_matrix(n, m, 1).T
+    return 2.0 * np.pi * np.mean(np.linalg.norm(dx, axis=-2), axis=-1)
+
+
+def rms_amplitude(c):
+    """⟨|d|²⟩^½ over s of a vector series d with coefficients c (3, 2n+1)."""
+    return np.sqrt(np.sum(c[:, 0] ** 2) + 0.5 * np.sum(c[:, 1:] ** 2))
+
+
+def mode_energy(c):
+    """E_k = ½ Σ_xyz (a_k² + b_k²) for k = 1..order (array of length order)."""
+    c = np.asarray(c, dtype=float)
+    order = spectral.order_of(c.shape[-1])
+    return 0.5 * np.sum(c[:, 1 : order + 1] ** 2 + c[:, order + 1 :] ** 2, axis=0)
+
+
+def spectral_tail(c, n):
+    """RMS relative amplitude in the modes k ≥ max(2, n - 1) of the series c:
+    sqrt(Σ_{k ≥ max(2, n-1)} E_k / Σ_{k ≥ 1} E_k)."""
+    energy = mode_energy(c)
+    total = energy.sum()
+    return float(np.sqrt(energy[max(2, n - 1) - 1 :].sum() / total)) if total > 0 else 0.0
+
+
+def truncation(c, n):
+    """RMS relative amplitude in the modes k > n of the series c."""
+    energy = mode_energy(c)
+    total = energy.sum()
+    return float(np.sqrt(energy[n:].sum() / total)) if total > 0 else 0.0
 
 
 def centre_of_mass(x):
@@ -78,3 +118,51 @@ def tension_extremes(x, multiplier):
     s, force = tension_profile(x, multiplier)
     i = int(np.argmax(force))
     return float(force[i]), float(np.min(force)), float(s[i])
+
+
+def stability_parameter(g0, theta_deg):
+    """q = g0 sin θ / 3 (paper §4), θ in degrees."""
+    return g0 * math.sin(math.radians(theta_deg)) / 3.0
+
+
+# ---- the registry -----------------------------------------------------------------
+#: A state: coefficients x (3, 2n+1), velocity u (3, 2n+1), tension multiplier (2n+1,), g0.
+State = collections.namedtuple("State", "x u multiplier g0")
+#: name: summary and sweep-table column; function(State) -> value; dtype: its Arrow/NumPy
+#: type name; trajectory: its column in the trajectory table (None: summary only).
+Diagnostic = collections.namedtuple("Diagnostic", "name function dtype trajectory doc")
+
+
+def _tension(index):
+    return lambda state: tension_extremes(state.x, state.multiplier)[index]
+
+
+REGISTRY = [
+    Diagnostic("theta_final_deg", lambda s: tilt_deg(s.x), "float64", "theta_deg",
+               "tilt of the best-fit plane to the horizontal (deg)"),
+    Diagnostic("q_final", lambda s: stability_parameter(s.g0, tilt_deg(s.x)), "float64", None,
+               "g0 sin(theta) / 3 at the final tilt"),
+    Diagnostic("aspect_ratio", lambda s: aspect_ratio(s.x), "float64", "aspect_ratio",
+               "largest / middle covariance eigenvalue"),
+    Diagnostic("axis_ratio", lambda s: axis_ratio(s.x), "float64", None,
+               "sqrt(aspect_ratio)"),
+    Diagnostic("u_x", lambda s: float(s.u[0, 0]), "float64", None, "centre-of-mass velocity, x"),
+    Diagnostic("u_y", lambda s: float(s.u[1, 0]), "float64", None, "centre-of-mass velocity, y"),
+    Diagnostic("u_z", lambda s: float(s.u[2, 0]), "float64", None, "centre-of-mass velocity, z"),
+    Diagnostic("settling_angle_deg", lambda s: settling_angle_deg(s.u[:, 0]), "float64", None,
+               "angle between the centre-of-mass velocity and gravity (deg)"),
+    Diagnostic("tension_max", _tension(0), "float64", "tension_max",
+               "largest axial force N = T + |x''|^2"),
+    Diagnostic("tension_min", _tension(1), "float64", "tension_min", "smallest axial force"),
+    Diagnostic("s_tension_max", _tension(2), "float64", None, "arc length of the largest force"),
+    Diagnostic("length_error", lambda s: relative_length_error(s.x), "float64", "length_error",
+               "(L - 2 pi) / 2 pi"),
+]
+
+
+def evaluate(state, trajectory=False):
+    """{name: value} of every registered diagnostic of ``state`` (``trajectory``: only
+    those with a trajectory column, keyed by that column)."""
+    if trajectory:
+        return {d.trajectory: d.function(state) for d in REGISTRY if d.trajectory}
+    return {d.name: d.function(state) for d in REGISTRY}

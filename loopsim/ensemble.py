@@ -6,7 +6,8 @@ temporary name and renamed into place.  A chunk is the unit of work: chunk k
 holds the cases with ``case_id % n_chunks == k`` (interleaved, so every
 chunk mixes cheap and costly corners of the grid).  Re-running the same sweep
 skips finished chunks; a different configuration in the same directory is
-refused.  No numerics here: integration is ``batch``, diagnostics ``api``.
+refused.  No numerics here: integration is ``batch``, start shapes
+``shapes``, summaries ``api``, tables ``io``.
 """
 import dataclasses
 import glob
@@ -20,9 +21,8 @@ import time
 import numpy as np
 import pandas as pd
 import pyarrow as pa
-import pyarrow.parquet as pq
 
-from . import api, batch, initial, integrate, io, problems, physics, shapes
+from . import api, batch, diagnostics, integrators, io, models, shapes, validation
 from .config import (
     DEFAULT_ATOL, DEFAULT_LENGTH_TOL, DEFAULT_MAX_STEPS, DEFAULT_PERTURBATION, DEFAULT_RTOL,
     DEFAULT_STEADY_INTERVAL, DEFAULT_STEADY_TOL, DEFAULT_T_END, DEFAULT_W,
@@ -58,27 +58,9 @@ def classify(theta0_deg, theta_final_deg, aspect_initial, aspect_final, ok, thre
     return "stable"
 
 
-# ---- the table -----------------------------------------------------------
-_FLOAT = pa.float64()
-_INT = pa.int64()
-_SUMMARY_TYPES = {
-    "n": _INT, "seed": _INT, "status": pa.string(), "steps_accepted": _INT,
-    "steps_rejected": _INT, "rhs_evals": _INT,
-}
-#: The declared schema of every chunk (and of ``read_results``).
-RESULT_SCHEMA = pa.schema(
-    [pa.field("case_id", _INT)]
-    + [pa.field(name, _SUMMARY_TYPES.get(name, _FLOAT)) for name in api.SUMMARY_FIELDS]
-    + [
-        pa.field("regime", pa.string()),
-        pa.field("stop_reason", pa.string()),
-        pa.field("aspect_ratio_initial", _FLOAT),
-        pa.field("length_error_max", _FLOAT),
-        pa.field("x_final", pa.list_(_FLOAT)),
-    ]
-)
+# ---- the table (schema: io.RESULT_SCHEMA) ----------------------------------
 FIELD_NOTES = {
-    "wall_s": "share of the chunk's wall time x threads, in proportion to rhs_evals",
+    "wall_s": "share of the chunk's wall time x threads, in proportion to nfev",
     "x_final": "terminal shape coefficients, row-major (3, 2n+1): " + io.COEFFICIENT_LAYOUT,
     "regime": "stable | in-plane | 3d | failed (see thresholds)",
     "stop_reason": "t_end | steady (terminal state reached early) | the failure",
@@ -128,7 +110,7 @@ class SweepConfig:
     thresholds: Thresholds = Thresholds()
 
     def step_options(self):
-        return integrate.step_options(
+        return integrators.step_options(
             self.rtol, self.atol, max_steps=self.max_steps, constraint_tol=self.length_tol,
             steady_interval=self.steady_interval if self.early_stop else 0.0,
             steady_tol=self.steady_tol)
@@ -185,25 +167,24 @@ def validate(config):
         raise ValueError("the sweep has no cases")
     for case_id, case in enumerate(config.cases):
         try:
-            api.check_real("g0", case["g0"], low=0.0)
-            api.check_real("theta0_deg", case["theta0_deg"], low=0.0, high=90.0)
-            api.check_integer("n", case["n"], 1)
-            api.check_integer("seed", case["seed"], 0)
-            api.check_real("perturbation", case["perturbation"], low=0.0)
+            validation.check_real("g0", case["g0"], low=0.0)
+            validation.check_tilt("theta0_deg", case["theta0_deg"])
+            validation.check_integer("n", case["n"], 1)
+            validation.check_integer("seed", case["seed"], 0)
+            validation.check_real("perturbation", case["perturbation"], low=0.0)
         except ValueError as exc:
             raise ValueError(f"case {case_id}: {exc}") from None
-    api.check_real("t_end", config.t_end, low=0.0, low_open=True)
-    api.check_real("rtol", config.rtol, low=0.0, low_open=True)
-    api.check_real("atol", config.atol, low=0.0)
-    api.check_real("w", config.w, low=0.0)
-    api.check_integer("chunk_size", config.chunk_size, 1)
-    api.check_integer("snapshot_count", config.snapshot_count, 2)
+    validation.check_real("t_end", config.t_end, low=0.0, low_open=True)
+    validation.check_real("rtol", config.rtol, low=0.0, low_open=True)
+    validation.check_real("atol", config.atol, low=0.0)
+    validation.check_real("w", config.w, low=0.0)
+    validation.check_integer("chunk_size", config.chunk_size, 1)
+    validation.check_integer("snapshot_count", config.snapshot_count, 2)
     for case_id in config.snapshots_for:
         if not 0 <= case_id < len(config.cases):
             raise ValueError(f"--snapshots-for names case {case_id}, but the sweep has cases "
                              f"0..{len(config.cases) - 1}")
-    if config.method not in integrate.METHODS:
-        raise ValueError(f"method must be one of {sorted(integrate.METHODS)}, got {config.method!r}")
+    validation.check_choice("method", config.method, integrators.METHODS)
 
 
 # ---- running ---------------------------------------------------------------
@@ -211,11 +192,13 @@ def chunk_case_ids(config, chunk):
     return list(range(chunk, len(config.cases), config.n_chunks))
 
 
-def _initial_shape(case):
+def _start(case):
+    """Keyword arguments of ``shapes.start_shape`` (and ``simulate``) for a case's start."""
     if case.get("initial"):  # a case started from a file (cases column "initial")
-        return shapes.case_shape(case)
-    return initial.initial_shape(case["n"], math.radians(case["theta0_deg"]),
-                                 case["perturbation"], case["seed"])
+        return dict(initial=case["initial"], initial_case_id=case.get("initial_case_id"),
+                    n=case["n"], perturbation=case["perturbation"], seed=case["seed"])
+    return dict(theta0_deg=case["theta0_deg"], n=case["n"], perturbation=case["perturbation"],
+                seed=case["seed"])
 
 
 def _result_row(config, case_id, case, x0, x, status_code, counts, worst_length, wall_s, t_final):
@@ -223,22 +206,20 @@ def _result_row(config, case_id, case, x0, x, status_code, counts, worst_length,
     n = case["n"]
     if not np.all(np.isfinite(x)):
         x = x0  # keep the row finite; the status says why
-    problem = problems.make_loop_problem(n, case["g0"], config.w)
-    u, multiplier = api._velocity_and_multiplier(problem, x)
+    problem = models.local_sbt.make_problem(n, case["g0"], config.w)
+    u, multiplier = api.velocity_and_multiplier(problem, x)
     inputs = dict(g0=case["g0"], theta0_deg=case["theta0_deg"], n=n, t_end=config.t_end,
                   rtol=config.rtol, atol=config.atol, w=config.w,
                   perturbation=case["perturbation"], seed=case["seed"])
     row = api.terminal_summary(
-        inputs, x, u, multiplier, status=integrate.STATUS_NAMES[status_code], t_final=t_final,
-        steps_accepted=int(counts[0]), steps_rejected=int(counts[1]), rhs_evals=int(counts[2]),
-        wall_s=wall_s,
-    )
-    aspect0 = api.diagnostics.aspect_ratio(x0)
+        inputs, x, u, multiplier, status=integrators.STATUS_NAMES[status_code], t_final=t_final,
+        wall_s=wall_s, **dict(zip(integrators.COUNTS, (int(c) for c in counts))))
+    aspect0 = diagnostics.aspect_ratio(x0)
     row.update(
         case_id=case_id, aspect_ratio_initial=aspect0, x_final=x.ravel().tolist(),
-        length_error_max=float(worst_length), stop_reason=integrate.STOP_REASONS[status_code],
+        length_error_max=float(worst_length), stop_reason=integrators.STOP_REASONS[status_code],
         regime=classify(case["theta0_deg"], row["theta_final_deg"], aspect0, row["aspect_ratio"],
-                        status_code in integrate.SUCCESS, config.thresholds),
+                        status_code in integrators.SUCCESS, config.thresholds),
     )
     return row
 
@@ -247,24 +228,20 @@ def _traced_case(config, case_id):
     """A case with snapshots: its row and trajectory come from one ``api.simulate`` run,
     so they agree exactly (its steps land on the snapshot times)."""
     case = config.cases[case_id]
-    start = dict(initial=case["initial"], initial_case_id=case.get("initial_case_id")) \
-        if case.get("initial") else {}
     result = api.simulate(
-        case["g0"], None if start else case["theta0_deg"], **start, n=case["n"],
-        t_span=(0.0, config.t_end),
+        case["g0"], **_start(case), t_span=(0.0, config.t_end),
         snapshots=config.snapshot_count, rtol=config.rtol, atol=config.atol, w=config.w,
-        perturbation=case["perturbation"], seed=case["seed"], method=config.method,
-        max_steps=config.max_steps, length_tol=config.length_tol,
+        method=config.method, max_steps=config.max_steps, length_tol=config.length_tol,
         steady_tol=config.steady_tol if config.early_stop else None,
         steady_interval=config.steady_interval)
     row = _result_row(config, case_id, case, result.x[0], result.x_final, result.status_code,
-                      (result.steps_accepted, result.steps_rejected, result.rhs_evals),
+                      [getattr(result, name) for name in integrators.COUNTS],
                       result.length_error_max, result.wall_s, result.t_final)
     table = io.trajectory_table(result).replace_schema_metadata(None)
     for name in ("x", "multiplier"):  # orders differ between cases: variable-length lists
         table = table.set_column(table.schema.get_field_index(name), name,
-                                 table.column(name).cast(pa.list_(_FLOAT)))
-    return row, table.add_column(0, "case_id", pa.array([case_id] * table.num_rows, _INT))
+                                 table.column(name).cast(pa.list_(pa.float64())))
+    return row, table.add_column(0, "case_id", pa.array([case_id] * table.num_rows, pa.int64()))
 
 
 def run_chunk(config, chunk, threads):
@@ -285,11 +262,11 @@ def run_chunk(config, chunk, threads):
     outputs = []
     for n, members in sorted(by_order.items()):
         cases = [config.cases[i] for i in members]
-        x0 = np.array([_initial_shape(c).ravel() for c in cases])
+        x0 = np.array([shapes.start_shape(**_start(c))[0].ravel() for c in cases])
         result = batch.integrate_cases(
-            integrate.METHODS[config.method], physics.make_operators(n),
-            [c["g0"] for c in cases], config.w, x0, config.t_end, config.step_options(),
-            cost=[api.stability_parameter(c["g0"], c["theta0_deg"]) for c in cases])
+            integrators.METHODS[config.method], models.local_sbt.make_operators(n),
+            [(c["g0"], config.w) for c in cases], x0, config.t_end, config.step_options(),
+            cost=[diagnostics.stability_parameter(c["g0"], c["theta0_deg"]) for c in cases])
         outputs.append((members, x0, result))
     wall = time.perf_counter() - start
     total_rhs = sum(int(result[3][:, 2].sum()) for _, _, result in outputs) or 1
@@ -305,17 +282,8 @@ def run_chunk(config, chunk, threads):
     for case_id in traced:
         rows[case_id], table = _traced_case(config, case_id)
         snapshots.append(table)
-    table = pa.Table.from_pylist([rows[i] for i in sorted(rows)], schema=RESULT_SCHEMA)
+    table = pa.Table.from_pylist([rows[i] for i in sorted(rows)], schema=io.RESULT_SCHEMA)
     return table, (pa.concat_tables(snapshots) if snapshots else None)
-
-
-def read_snapshots(out):
-    """Trajectory snapshots of the cases chosen with ``snapshots_for`` (a DataFrame)."""
-    paths = sorted(glob.glob(os.path.join(out, "snapshots-*.parquet")))
-    if not paths:
-        return pd.DataFrame()
-    frame = pa.concat_tables([pq.read_table(p) for p in paths]).to_pandas()
-    return frame.sort_values(["case_id", "t"], kind="stable").reset_index(drop=True)
 
 
 class Progress:
@@ -398,21 +366,4 @@ def run_sweep(config, out, threads=None, quiet=False, command_line=None):
         failures = sum(1 for s in table.column("status").to_pylist() if s != "ok")
         progress.update(table.num_rows, failures)
     progress.close()
-    return read_results(out)
-
-
-def read_results(out):
-    """All finished cases of a sweep directory as a DataFrame sorted by case_id.
-
-    The sweep's metadata (configuration, thresholds, versions, command line)
-    is in ``frame.attrs["loopsim"]``.
-    """
-    paths = sorted(glob.glob(os.path.join(out, "chunk-*.parquet")))
-    if not os.path.isdir(out):
-        raise ValueError(f"no sweep directory at {out!r}")
-    if not paths:
-        return RESULT_SCHEMA.empty_table().to_pandas()
-    table = pa.concat_tables([pq.read_table(p, schema=RESULT_SCHEMA) for p in paths])
-    frame = table.to_pandas().sort_values("case_id", kind="stable").reset_index(drop=True)
-    frame.attrs["loopsim"] = io.read_metadata(paths[0])
-    return frame
+    return io.read_results(out)

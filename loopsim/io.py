@@ -1,21 +1,57 @@
-"""Parquet output with the provenance a reader needs (pyarrow schema metadata)."""
+"""Tables: the declared schemas, Parquet writing with provenance, and the readers.
+
+Every table loopsim writes carries schema-level metadata (versions, the
+coefficient layout, the run or sweep configuration); files are written to a
+temporary name and renamed into place.
+"""
 import datetime
+import glob
 import json
 import os
 import tempfile
 
 import numba
 import numpy as np
+import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from . import __version__, diagnostics
+from . import diagnostics
+from ._version import __version__
 
 COEFFICIENT_LAYOUT = (
     "x coefficients: row-major (component x,y,z; coefficient [a0, a1..an, b1..bn]) "
     "with f(s) = a0 + sum_k a_k cos ks + b_k sin ks, s in [0, 2pi); "
     "multiplier: the tension Lagrange multiplier T in the same layout; "
     "physical tension N = T + |x''|^2"
+)
+
+
+#: Summary fields, in order; they are also the sweep table's columns.
+INPUT_FIELDS = ("g0", "theta0_deg", "n", "q0", "t_end", "rtol", "atol", "w", "perturbation",
+                "seed")
+RUN_FIELDS = ("status", "t_final", "steps_accepted", "steps_rejected", "nfev", "njev", "nlu",
+              "wall_s")
+SUMMARY_FIELDS = INPUT_FIELDS + RUN_FIELDS + tuple(d.name for d in diagnostics.REGISTRY)
+
+_FLOAT = pa.float64()
+_INT = pa.int64()
+_SUMMARY_TYPES = {
+    "n": _INT, "seed": _INT, "status": pa.string(), "steps_accepted": _INT,
+    "steps_rejected": _INT, "nfev": _INT, "njev": _INT, "nlu": _INT,
+    **{d.name: pa.from_numpy_dtype(np.dtype(d.dtype)) for d in diagnostics.REGISTRY},
+}
+#: The declared schema of every sweep chunk (and of :func:`read_results`).
+RESULT_SCHEMA = pa.schema(
+    [pa.field("case_id", _INT)]
+    + [pa.field(name, _SUMMARY_TYPES.get(name, _FLOAT)) for name in SUMMARY_FIELDS]
+    + [
+        pa.field("regime", pa.string()),
+        pa.field("stop_reason", pa.string()),
+        pa.field("aspect_ratio_initial", _FLOAT),
+        pa.field("length_error_max", _FLOAT),
+        pa.field("x_final", pa.list_(_FLOAT)),
+    ]
 )
 
 
@@ -51,20 +87,19 @@ def write_table_atomically(table, path):
 def trajectory_table(result, command_line=None):
     """One row per snapshot: time, shape coefficients, multiplier and diagnostics."""
     k = result.x.shape[-1]
-    rows = [diagnostics.tension_extremes(x, m) for x, m in zip(result.x, result.multiplier)]
-    columns = {
-        "t": pa.array(result.t, pa.float64()),
-        "theta_deg": pa.array([diagnostics.tilt_deg(x) for x in result.x], pa.float64()),
-        "aspect_ratio": pa.array([diagnostics.aspect_ratio(x) for x in result.x], pa.float64()),
-        "tension_max": pa.array([r[0] for r in rows], pa.float64()),
-        "tension_min": pa.array([r[1] for r in rows], pa.float64()),
-        "length_error": pa.array(
-            [diagnostics.relative_length_error(x) for x in result.x], pa.float64()),
+    rows = [diagnostics.evaluate(diagnostics.State(x, u, m, result.inputs["g0"]), trajectory=True)
+            for x, u, m in zip(result.x, result.u, result.multiplier)]
+    columns = {"t": pa.array(result.t, pa.float64())}
+    for d in diagnostics.REGISTRY:
+        if d.trajectory:
+            columns[d.trajectory] = pa.array([r[d.trajectory] for r in rows],
+                                             pa.from_numpy_dtype(np.dtype(d.dtype)))
+    columns.update({
         "x": pa.FixedSizeListArray.from_arrays(
             pa.array(result.x.reshape(-1), pa.float64()), 3 * k),
         "multiplier": pa.FixedSizeListArray.from_arrays(
             pa.array(result.multiplier.reshape(-1), pa.float64()), k),
-    }
+    })
     table = pa.table(columns)
     meta = provenance(summary=result.summary(), command_line=command_line or [])
     return table.replace_schema_metadata(meta)
@@ -86,3 +121,29 @@ def read_metadata(path):
         except json.JSONDecodeError:
             out[key] = value
     return out
+
+
+def read_snapshots(out):
+    """Trajectory snapshots of the cases chosen with ``snapshots_for`` (a DataFrame)."""
+    paths = sorted(glob.glob(os.path.join(out, "snapshots-*.parquet")))
+    if not paths:
+        return pd.DataFrame()
+    frame = pa.concat_tables([pq.read_table(p) for p in paths]).to_pandas()
+    return frame.sort_values(["case_id", "t"], kind="stable").reset_index(drop=True)
+
+
+def read_results(out):
+    """All finished cases of a sweep directory as a DataFrame sorted by case_id.
+
+    The sweep's metadata (configuration, thresholds, versions, command line)
+    is in ``frame.attrs["loopsim"]``.
+    """
+    paths = sorted(glob.glob(os.path.join(out, "chunk-*.parquet")))
+    if not os.path.isdir(out):
+        raise ValueError(f"no sweep directory at {out!r}")
+    if not paths:
+        return RESULT_SCHEMA.empty_table().to_pandas()
+    table = pa.concat_tables([pq.read_table(p, schema=RESULT_SCHEMA) for p in paths])
+    frame = table.to_pandas().sort_values("case_id", kind="stable").reset_index(drop=True)
+    frame.attrs["loopsim"] = read_metadata(paths[0])
+    return frame

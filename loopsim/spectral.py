@@ -57,14 +57,17 @@ def derivative_matrix(n, order=1):
     return np.linalg.matrix_power(d, order)
 
 
+def basis(n, s):
+    """(len(s), 2n+1) matrix of the basis [1, cos ks, sin ks] at the points s."""
+    s = np.atleast_1d(np.asarray(s, dtype=float))
+    k = np.arange(1, n + 1)
+    return np.concatenate((np.ones((s.size, 1)), np.cos(np.outer(s, k)), np.sin(np.outer(s, k))),
+                          axis=1)
+
+
 def synthesis_matrix(n, m, order=0):
     """(m, 2n+1) matrix evaluating the order-th derivative of a series on the m-point grid."""
-    s = grid(m)
-    k = np.arange(1, n + 1)
-    basis = np.concatenate(
-        (np.ones((m, 1)), np.cos(np.outer(s, k)), np.sin(np.outer(s, k))), axis=1
-    )
-    return basis @ derivative_matrix(n, order)
+    return basis(n, grid(m)) @ derivative_matrix(n, order)
 
 
 def analysis_matrix(n, m):

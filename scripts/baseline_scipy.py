@@ -8,7 +8,7 @@ the direct way: dense NumPy arrays on the 4n + 1 point grid, the tension
 matrix built column by column, ``numpy.linalg.lstsq``, and
 ``scipy.integrate.solve_ivp`` with Radau or BDF (finite-difference Jacobian),
 and, as a careful user would, Radau with the exact chain-rule Jacobian in
-plain NumPy (``loopsim.full_stability.rhs_jacobian``).  Nothing else from
+plain NumPy (``scripts/numpy_jacobian.py``).  Nothing else from
 loopsim's numerics is used; the initial shape and the error measure come from
 loopsim so both start from the same state.
 
@@ -24,7 +24,8 @@ import numpy as np
 from scipy.integrate import solve_ivp
 
 import loopsim
-from loopsim import full_stability, initial
+from loopsim import shapes
+from numpy_jacobian import rhs_jacobian
 
 
 class NumpyLoop:
@@ -44,7 +45,10 @@ class NumpyLoop:
         self.K = 2 * n + 1
 
     def __call__(self, t, y):
-        x = y.reshape(3, self.K)
+        return self.velocity_and_tension(y.reshape(3, self.K))[0].ravel()
+
+    def velocity_and_tension(self, x):
+        """Velocity coefficients (3, K) and tension multiplier (K,) of shape x."""
         tangent, curvature = x @ self.dS.T, x @ self.ddS.T
         x4 = x @ self.d4S.T
         gravity = np.array([0.0, 0.0, self.g0])[:, None]
@@ -68,7 +72,7 @@ class NumpyLoop:
                    for j in range(self.K)]
         tension = np.linalg.lstsq(np.array(columns).T, -b, rcond=None)[0]
         v = b_v + velocity_grid(self.S @ tension, self.dS @ tension, False)
-        return (v @ self.F.T).ravel()
+        return v @ self.F.T, tension
 
 
 def main():
@@ -88,16 +92,16 @@ def main():
     loopsim.simulate(args.g0, args.theta0, n=n, t_span=(0, 0.01))  # JIT warm-up
     reference = loopsim.simulate(args.g0, args.theta0, rtol=1e-12, atol=1e-14,
                                  method=args.reference_method, **run).x_final
-    x0 = initial.initial_shape(n, np.radians(args.theta0), 1e-3, 0)
+    x0 = shapes.initial_shape(n, np.radians(args.theta0), 1e-3, 0)
     rhs = NumpyLoop(n, args.g0, loopsim.config.DEFAULT_W)
     u_check = rhs(0.0, x0.ravel()).reshape(3, -1)
     u_loopsim, _ = loopsim.evaluate_maps(x0, args.g0)
     print(f"# n = {n}, g0 = {args.g0}, theta0 = {args.theta0}, t_end = {args.t_end}; "
           f"baseline RHS agrees with loopsim to {np.abs(u_check - u_loopsim).max():.1e}")
-    print(f"{'solver':>22} {'rtol':>7} {'wall_s':>8} {'rhs_evals':>9} {'error':>8}")
+    print(f"{'solver':>22} {'rtol':>7} {'wall_s':>8} {'nfev':>9} {'error':>8}")
     results = []
-    def exact_jacobian(t, y):  # the chain-rule Jacobian, plain NumPy (loopsim.full_stability)
-        return full_stability.rhs_jacobian(y.reshape(3, -1), args.g0)
+    def exact_jacobian(t, y):  # the chain-rule Jacobian, plain NumPy (numpy_jacobian.py)
+        return rhs_jacobian(y.reshape(3, -1), args.g0, rhs.w, rhs.velocity_and_tension)
 
     variants = {"radau": ("Radau", None), "bdf": ("BDF", None), "radau-exact": ("Radau", exact_jacobian)}
     for method, jac in (variants[v] for v in args.baselines.split(",")):
@@ -126,7 +130,7 @@ def main():
             error = np.abs(result.x_final - reference).max()
             label = f"loopsim {method}"
             results.append((label, rtol, result.wall_s, error))
-            print(f"{label:>22} {rtol:>7.0e} {result.wall_s:>8.3f} {result.rhs_evals:>9} "
+            print(f"{label:>22} {rtol:>7.0e} {result.wall_s:>8.3f} {result.nfev:>9} "
                   f"{error:>8.1e}", flush=True)
     for target in (1e-4, 1e-6):
         base = [r for r in results if r[0].startswith("scipy") and r[3] <= target]

@@ -17,7 +17,9 @@ import time
 import numba
 import numpy as np
 
-from loopsim import batch, ensemble, initial, integrate, physics
+import loopsim
+from loopsim import batch, ensemble, integrators, shapes
+from loopsim.models import local_sbt
 
 
 def timed_sweep(config, threads):
@@ -63,23 +65,24 @@ def main():
           f"max |d aspect ratio| {np.abs(full['aspect_ratio'] - early['aspect_ratio']).max():.1e}, "
           f"max |d tilt| {np.abs(full['theta_final_deg'] - early['theta_final_deg']).max():.1e} deg")
     print("# cost split by regime (full runs):")
-    total = full["rhs_evals"].sum()
+    total = full["nfev"].sum()
     for regime, rows in full.groupby("regime"):
-        print(f"#   {regime:>8}: {len(rows):3d} cases, mean rhs_evals {rows['rhs_evals'].mean():9.0f}, "
-              f"{rows['rhs_evals'].sum() / total:.0%} of all work")
+        print(f"#   {regime:>8}: {len(rows):3d} cases, mean nfev {rows['nfev'].mean():9.0f}, "
+              f"{rows['nfev'].sum() / total:.0%} of all work")
 
-    ops = physics.make_operators(args.n)
-    x0 = np.array([initial.initial_shape(args.n, math.radians(c["theta0_deg"]), c["perturbation"],
+    operators = local_sbt.make_operators(args.n)
+    x0 = np.array([shapes.initial_shape(args.n, math.radians(c["theta0_deg"]), c["perturbation"],
                                          c["seed"]).ravel() for c in cases])
     g0 = [c["g0"] for c in cases]
     options = ensemble.SweepConfig(cases=cases, early_stop=False).step_options()
-    method_id = integrate.METHODS[args.method]
+    method_id = integrators.METHODS[args.method]
     numba.set_num_threads(2)
-    q0 = [c["g0"] * math.sin(math.radians(c["theta0_deg"])) / 3 for c in cases]
+    q0 = [loopsim.stability_parameter(c["g0"], c["theta0_deg"]) for c in cases]
     walls = {}
     for label, cost in (("grid order", None), ("by q0", q0)):
         start = time.perf_counter()
-        batch.integrate_cases(method_id, ops, g0, 10.0, x0, 3.0, options, cost=cost)
+        batch.integrate_cases(method_id, operators, np.column_stack([g0, np.full(len(g0), 10.0)]), x0, 3.0,
+                              options, cost=cost)
         walls[label] = time.perf_counter() - start
     print(f"# load balance, 2 threads, one batch, t_end = 3: lanes in grid order "
           f"{walls['grid order']:.1f} s, by decreasing q0 {walls['by q0']:.1f} s "

@@ -38,8 +38,8 @@ def main():
             frames[method] = ensemble.run_sweep(config, out, quiet=True)
             wall = time.perf_counter() - start
         f = frames[method]
-        print(f"{method:>7}: {len(f)} seeds, wall {wall:.1f} s, mean rhs_evals "
-              f"{f['rhs_evals'].mean():.0f}, status ok {int((f['status'] == 'ok').sum())}; "
+        print(f"{method:>7}: {len(f)} seeds, wall {wall:.1f} s, mean nfev "
+              f"{f['nfev'].mean():.0f}, status ok {int((f['status'] == 'ok').sum())}; "
               f"tilt {f['theta_final_deg'].mean():.2f} ± {f['theta_final_deg'].std():.2f} deg, "
               f"aspect ratio {f['aspect_ratio'].mean():.3f} ± {f['aspect_ratio'].std():.3f}, "
               f"regimes {f['regime'].value_counts().to_dict()}", flush=True)

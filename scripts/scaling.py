@@ -19,7 +19,8 @@ import numba
 import numpy as np
 
 import loopsim
-from loopsim import initial, physics, problems
+from loopsim import shapes
+from loopsim.models import local_sbt as physics
 
 
 @numba.njit(cache=True)
@@ -69,8 +70,8 @@ def main():
     print(f"{'n':>3} {'us/rhs':>8} {'maps':>7} {'lstsq':>7} {'rest':>6} {'steps':>7} "
           f"{'mean_h':>9} {'3.7/lmax':>9} {'traj_s':>8} {'stepper%':>8}")
     for n in orders:
-        x = initial.initial_shape(n, np.radians(30.0), 1e-3, 0)
-        problem = problems.make_loop_problem(n, g0, w)
+        x = shapes.initial_shape(n, np.radians(30.0), 1e-3, 0)
+        problem = physics.make_problem(n, g0, w)
         ops, ws = problem.ops, problem.ws
         u = np.empty_like(x)
         repeats = max(200, int(2e5 / n**3))
@@ -80,7 +81,7 @@ def main():
         block = ws.length_rate.copy()
         solve = per_call(_time_solve, (block, ws), repeats) - per_call(_time_copy, (block, ws), repeats)
         result = loopsim.simulate(g0, 30.0, n=n, t_span=(0, args.t_end))
-        stepper = 1 - result.rhs_evals * rhs * 1e-6 / result.wall_s
+        stepper = 1 - result.nfev * rhs * 1e-6 / result.wall_s
         bound = 3.7 / (1.5 * n**2 * (n**2 - 1))
         rows.append((n, rhs, result.wall_s * 10 / args.t_end))
         print(f"{n:>3} {rhs:>8.2f} {maps:>7.2f} {solve:>7.2f} {rhs - maps - solve:>6.2f} "

@@ -31,7 +31,7 @@ import numpy as np
 import pandas as pd
 
 import loopsim
-from loopsim import diagnostics, integrate
+from loopsim import diagnostics, integrators
 
 CASES = {
     "in-plane": dict(g0=60.0, theta0=30.0, t_end=10.0, orders=[4, 6, 8, 12, 16], n_ref=20),
@@ -58,7 +58,7 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--out", default="runs/work_precision")
     parser.add_argument("--quick", action="store_true", help="fewer orders and tolerances")
-    parser.add_argument("--methods", default=",".join(sorted(integrate.METHODS)))
+    parser.add_argument("--methods", default=",".join(sorted(integrators.METHODS)))
     parser.add_argument("--all", action="store_true", help="include RKF45 in-plane runs at n >= 16")
     parser.add_argument("--plot-only", action="store_true", help="redraw OUT.png from OUT.parquet")
     args = parser.parse_args()
@@ -75,7 +75,7 @@ def main():
             if method == "rkf45" and label == "in-plane" and not args.all:
                 orders = [n for n in orders if n < 16]
             # the converged reference comes from the stiff solver when it exists (cheap at high n)
-            reference_method = "radau5" if "radau5" in integrate.METHODS else method
+            reference_method = "radau5" if "radau5" in integrators.METHODS else method
             converged = run(case, case["n_ref"], 1e-12, reference_method).x_final
             for n in orders:
                 reference = run(case, n, 1e-12, reference_method).x_final
@@ -85,7 +85,7 @@ def main():
                     x = result.x_final
                     rows.append(dict(
                         method=method, case=label, n=n, rtol=rtol, status=result.status,
-                        wall_s=result.wall_s, rhs_evals=result.rhs_evals,
+                        wall_s=result.wall_s, nfev=result.nfev,
                         steps=result.steps_accepted, mean_step=result.t_final / result.steps_accepted,
                         time_error=float(np.abs(x - reference).max()),
                         time_error_aspect=abs(diagnostics.aspect_ratio(x) - diagnostics.aspect_ratio(reference)),

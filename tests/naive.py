@@ -84,3 +84,57 @@ def random_shape(rng, n, amplitude=0.2, theta=0.7):
     k = np.concatenate(([1.0], np.arange(1, n + 1), np.arange(1, n + 1)))
     x += amplitude * rng.standard_normal(x.shape) / k**3
     return x
+
+
+def jacobian(x, g0, w, h=5e-5):
+    """∂u/∂x (3K × 3K, acting on x.ravel()) of :func:`tension_and_velocity` by
+    Richardson-extrapolated central differences: (4 D(h/2) − D(h)) / 3, error O(h⁴).
+
+    The step for a coefficient of wavenumber k is h max(1, max|x|) / k (x' changes
+    by the same amount for every k).  The truncation error still grows quickly
+    with n (terms like (k h)⁴ times high powers of x'), the rounding error is
+    ~1e-16 |u| / step: h = 5e-5 balances them for n = 3..8, where the result
+    agrees with the exact Jacobian to ≲ 1.4e-10 max|J| (tests/test_twins.py).
+    """
+    x = np.asarray(x, dtype=float)
+    n = (x.shape[-1] - 1) // 2
+    flat = x.ravel()
+    wavenumber = np.tile(np.concatenate(([1.0], np.arange(1, n + 1), np.arange(1, n + 1))), 3)
+    steps = h * max(1.0, np.abs(flat).max()) / wavenumber
+
+    def u_of(y):
+        return tension_and_velocity(y.reshape(x.shape), g0, w)[1].ravel()
+
+    def central(delta, j):
+        e = np.zeros_like(flat)
+        e[j] = delta
+        return (u_of(flat + e) - u_of(flat - e)) / (2 * delta)
+
+    jac = np.empty((flat.size, flat.size))
+    for j in range(flat.size):
+        jac[:, j] = (4 * central(steps[j] / 2, j) - central(steps[j], j)) / 3
+    return jac
+
+
+def lu_solve(a, b):
+    """x with a x = b (numpy.linalg.solve, i.e. LAPACK gesv)."""
+    return np.linalg.solve(a, b)
+
+
+def relative_length_error(x, m=FINE):
+    """(L − 2π) / 2π with L = ∫|x'| ds as the mean of |x'| on an m-point FFT grid."""
+    speed = np.sqrt(np.sum(to_grid(x, 1, m) ** 2, axis=0))
+    return speed.mean() - 1.0
+
+
+def shape_invariants(x, m=FINE):
+    """[covariance eigenvalues ascending, |n_z|] from m sampled points of the curve.
+
+    C = mean over the grid of (x(s) − x̄)(x(s) − x̄)ᵀ (exact for m > 2n: the
+    integrand has order 2n); n is the eigenvector of the smallest eigenvalue.
+    """
+    points = to_grid(x, 0, m)
+    centred = points - points.mean(axis=1, keepdims=True)
+    cov = centred @ centred.T / m
+    values, vectors = np.linalg.eigh(cov)
+    return np.append(values, abs(vectors[2, 0]))

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 import loopsim
-from loopsim import initial
+from loopsim import shapes
 
 
 def mode_amplitudes(x, modes):
@@ -15,7 +15,7 @@ def mode_amplitudes(x, modes):
 def _successive_differences(orders, t_end):
     shapes = [loopsim.simulate(60.0, 30.0, n=n, t_span=(0, t_end)) for n in orders]
     for r in shapes:
-        assert r.ok
+        assert r.success
     ar = np.array([r.summary()["aspect_ratio"] for r in shapes])
     amps = np.array([mode_amplitudes(r.x_final, 4) for r in shapes])
     return np.abs(np.diff(ar)), np.abs(np.diff(amps, axis=0)).max(axis=1), ar
@@ -43,11 +43,11 @@ def test_in_plane_terminal_shape_converges_at_t10():
     2..n, so it differs with n, and the in-plane terminal shape depends on the
     start (1.318–1.358 over seeds 0–3 at n = 12: 1.339, 1.349, 1.358, 1.318), which would mask convergence.
     """
-    x0 = initial.initial_shape(6, np.radians(30.0), 1e-3, 0)
+    x0 = shapes.initial_shape(6, np.radians(30.0), 1e-3, 0)
     ratios = []
     for n in (6, 8, 10, 12, 14, 16):
         result = loopsim.simulate(60.0, initial=x0, n=n, rtol=1e-10, atol=1e-13, method="radau5")
-        assert result.ok
+        assert result.success
         ratios.append(result.summary()["aspect_ratio"])
     d_ar = np.abs(np.diff(ratios))
     assert np.all(d_ar[1:] < d_ar[:-1] / 5), d_ar

@@ -13,10 +13,10 @@ import pyarrow.parquet as pq
 import pytest
 
 import loopsim
-from loopsim import ensemble
+from loopsim import ensemble, io
 from loopsim.cli import main
 
-DETERMINISTIC = [c for c in ensemble.RESULT_SCHEMA.names if c != "wall_s"]
+DETERMINISTIC = [c for c in io.RESULT_SCHEMA.names if c != "wall_s"]
 
 
 def small_config(**kwargs):
@@ -58,7 +58,7 @@ def test_sweep_schema_round_trip_and_thread_reproducibility(tmp_path):
     assert list(one["case_id"]) == list(range(6))
     pd.testing.assert_frame_equal(one[DETERMINISTIC], two[DETERMINISTIC])  # bit for bit
     for path in (tmp_path / "one").glob("chunk-*.parquet"):
-        assert pq.read_schema(path).remove_metadata() == ensemble.RESULT_SCHEMA
+        assert pq.read_schema(path).remove_metadata() == io.RESULT_SCHEMA
     meta = one.attrs["loopsim"]
     assert meta["sweep_config"]["t_end"] == 0.5 and meta["thresholds"]["tilt_change_deg"] == 1.0
     assert meta["loopsim_version"] == loopsim.__version__

@@ -1,4 +1,4 @@
-"""Tests for loopsim.full_stability: the Jacobian of loopsim's own RHS about the
+"""Tests for loopsim.stability.circle: the Jacobian of loopsim's own RHS about the
 translating circle, its neutral modes, sectors, thresholds and the comparison
 with the paper's operator.
 
@@ -16,26 +16,39 @@ import sys
 import numpy as np
 import pytest
 
-from loopsim import full_stability as fs
-from loopsim import initial, linear_stability
+from loopsim import api, shapes
+from loopsim.stability import circle as fs
+from loopsim.stability import onset, paper
 from loopsim.cli import main
 
 Q_IN = 8.9000904456      # in-plane critical q (converged, see docs/stability.md)
 Q_OUT = 10.6493156061    # out-of-plane critical q
 
 
+def _central_fd(x, g0, w, h):
+    """(u(x + h e) - u(x - h e)) / 2h for every coordinate e of x.ravel()."""
+    jac = np.empty((x.size, x.size))
+    for i in range(x.size):
+        e = np.zeros(x.size)
+        e[i] = h
+        up, _ = api.evaluate_maps(x + e.reshape(x.shape), g0, w)
+        um, _ = api.evaluate_maps(x - e.reshape(x.shape), g0, w)
+        jac[:, i] = ((up - um) / (2.0 * h)).ravel()
+    return jac
+
+
 def _richardson_fd(x, g0, w, h=2e-5):
-    return (4.0 * fs.rhs_jacobian_fd(x, g0, w, h / 2) - fs.rhs_jacobian_fd(x, g0, w, h)) / 3.0
+    return (4.0 * _central_fd(x, g0, w, h / 2) - _central_fd(x, g0, w, h)) / 3.0
 
 
 @pytest.mark.parametrize("shape", ["circle", "perturbed"])
 def test_jacobian_matches_finite_differences(shape):
     n, g0, w, th = 5, 40.0, 10.0, math.radians(35.0)
-    x = (initial.inclined_circle(n, th) if shape == "circle"
-         else initial.initial_shape(n, th, 0.05, 3))   # a shape with a nonzero tension residual
+    x = (shapes.inclined_circle(n, th) if shape == "circle"
+         else shapes.initial_shape(n, th, 0.05, 3))   # a shape with a nonzero tension residual
     jac = fs.rhs_jacobian(x, g0, w)
     scale = np.abs(jac).max()
-    assert np.abs(jac - fs.rhs_jacobian_fd(x, g0, w, 1e-6)).max() < 1e-7 * scale
+    assert np.abs(jac - _central_fd(x, g0, w, 1e-6)).max() < 1e-7 * scale
     assert np.abs(jac - _richardson_fd(x, g0, w)).max() < 1e-10 * scale
 
 
@@ -111,9 +124,10 @@ def test_stretch_modes_are_penalty_artefacts():
 
 def test_jacobian_is_affine_in_g0():
     lin = fs.linearise_circle(9, 3 * 7.3 / math.sin(math.radians(40.0)), 40.0)
-    pencil = fs._pencil(9, 40.0, 10.0)
+    lin0 = fs.linearise_circle(9, 0.0, 40.0)
+    lin1 = fs.linearise_circle(9, 3.0 / math.sin(math.radians(40.0)), 40.0)
     for s in fs.SECTORS:
-        b0, b1 = pencil[s]
+        b0, b1 = lin0.blocks[s], lin1.blocks[s] - lin0.blocks[s]
         assert np.abs(lin.blocks[s] - (b0 + 7.3 * b1)).max() < 1e-11 * np.abs(b0).max()
 
 
@@ -121,20 +135,20 @@ def test_out_of_plane_sector_is_the_corrected_operator():
     n, q = 9, 6.3
     lin = fs.linearise_circle(n, 3 * q / math.sin(math.radians(50.0)), 50.0)
     got = np.sort(np.linalg.eigvals(lin.blocks["out-of-plane"]).real)
-    ref = np.sort(np.repeat(np.linalg.eigvals(fs.corrected_operator(q, n)).real, 2))
+    ref = np.sort(np.repeat(np.linalg.eigvals(paper.paper_operator(q, n, corrected=True)).real, 2))
     np.testing.assert_allclose(got, ref, rtol=1e-11)
     # corrected operator = paper's operator minus 2∂² (the paper's T0 is off by +2); the paper's
     # k = 1 mode (a rigid rotation) decays at -2 instead of being neutral
     k = np.arange(2, n + 1.0)
-    paper = linear_stability.paper_operator(q, n)
-    np.testing.assert_allclose(paper[1:, 1:] - fs.corrected_operator(q, n), np.diag(-2 * k**2),
-                               atol=1e-12)
-    assert paper[0, 0] == -2.0 and paper[1, 0] == 0.0
+    printed = paper.paper_operator(q, n)
+    np.testing.assert_allclose(printed[1:, 1:] - paper.paper_operator(q, n, corrected=True),
+                               np.diag(-2 * k**2), atol=1e-12)
+    assert printed[0, 0] == -2.0 and printed[1, 0] == 0.0
 
 
 def test_corrected_operator_closed_form_n3():
     # k = 2, 3 block: det [[-12, -6q], [-q, -72]] = 0  ->  q = 12
-    assert fs.corrected_critical_q(3) == pytest.approx(12.0, rel=1e-13)
+    assert paper.critical_q(3, corrected=True) == pytest.approx(12.0, rel=1e-13)
     assert fs.critical_q(3, "out-of-plane") == pytest.approx(12.0, rel=1e-10)
 
 
@@ -187,14 +201,14 @@ def test_unstable_modes_are_k2_on_the_fore_side():
 def test_onset_q():
     eps, t_end, detect = 1e-3, 10.0, 1e-2
     for s in fs.SECTORS:
-        q_on = fs.onset_q(eps, t_end, detect, 8, s)
+        q_on = onset.onset_q(eps, t_end, detect, 8, s)
         assert q_on > fs.critical_q(8, s)
         assert fs.sector_growth_rates([q_on], 8)[s][0] == pytest.approx(math.log(detect / eps) / t_end,
                                                                          abs=1e-9)
 
 
 def test_cli_full_json(capsys):
-    assert main(["stability", "--full", "--n", "10", "--theta0", "30", "--json",
+    assert main(["stability", "--n", "10", "--theta0", "30", "--json",
                  "--q-scan", "0,12", "--g0", "40", "--top", "4"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["q_crit_in_plane"] == pytest.approx(Q_IN, rel=1e-9)
@@ -205,16 +219,34 @@ def test_cli_full_json(capsys):
     assert out["spectrum"]["sector"] == ["in-plane", "in-plane", "out-of-plane", "out-of-plane"]
 
 
-def test_cli_without_full_is_unchanged():
-    done = subprocess.run([sys.executable, "-m", "loopsim", "stability", "--n-max", "4", "--json"],
-                          capture_output=True, text=True, check=True)
-    assert json.loads(done.stdout) == {"operator": "paper", "critical_q": {
-        str(n): (None if math.isnan(q) else q) for n, q in linear_stability.critical_q_table(4)}}
+def test_cli_paper_table_with_its_caveat():
+    done = subprocess.run([sys.executable, "-m", "loopsim", "stability", "--paper", "--n-max", "4",
+                           "--json"], capture_output=True, text=True, check=True)
+    assert json.loads(done.stdout) == {"operator": "paper", "note": paper.SIGN_NOTE, "critical_q": {
+        str(n): (None if math.isnan(q) else q) for n, q in paper.critical_q_table(4)}}
+
+
+def test_cli_default_is_the_full_linearisation(capsys):
+    assert main(["stability", "--n", "10"]) == 0
+    out = capsys.readouterr().out
+    assert "q_crit_in_plane" in out and "8.9000" in out and "10.6493" in out
+    assert "wrong sign" in out  # the paper's value is printed with its caveat
+
+
+@pytest.mark.parametrize("argv", [["--paper", "--n", "10"], ["--paper", "--g0", "3"],
+                                  ["--n-max", "4"], ["--full"]])
+def test_cli_refuses_flag_mixtures(argv, capsys):
+    try:
+        code = main(["stability", *argv])
+    except SystemExit as exc:  # argparse: an unknown option
+        code = exc.code
+    assert code == 2
+    assert "error" in capsys.readouterr().err
 
 
 def test_cli_full_rejects_bad_input(capsys):
-    assert main(["stability", "--full", "--n", "2"]) == 2
-    assert main(["stability", "--full", "--theta0", "0"]) == 2
+    assert main(["stability", "--n", "2"]) == 2
+    assert main(["stability", "--theta0", "0"]) == 2
 
 
 @pytest.mark.slow
@@ -227,7 +259,7 @@ def test_critical_q_converged_high_n():
 def test_regime_onsets_bracket_the_sweep():
     """n = 6, eps = 1e-3, seed 0, t_end = 10, θ0 = 90°: the main-job sweep (README) labels
     q = 8.81 stable, 9.11 in-plane and q = 11.43 (θ0 = 90°) 3D."""
-    r = fs.regime_onsets(eps=1e-3, t_end=10.0, n=6, theta0_deg=90.0, seed=0)
+    r = onset.regime_onsets(eps=1e-3, t_end=10.0, n=6, theta0_deg=90.0, seed=0)
     assert r["q_crit_in_plane"] < r["q_in_plane"] < 9.11
     assert r["q_crit_out_of_plane"] < r["q_3d"] < 11.43
     assert 0 < r["amplitude_out_of_plane"] < 1e-3 and 0 < r["amplitude_in_plane"] < 1e-3

@@ -8,7 +8,7 @@ import pytest
 from scipy import integrate, special
 
 import loopsim
-from loopsim import api, ensemble, initial, io, shapes, spectral
+from loopsim import api, ensemble, io, shapes, spectral
 from loopsim.cli import main
 
 EXAMPLE = os.path.join(os.path.dirname(__file__), os.pardir, "data", "wobbly_ellipse.csv")
@@ -40,7 +40,7 @@ def test_circle_points_reproduce_the_builtin_circle(tmp_path, rng, suffix):
     points = centre + radius * np.stack(
         [np.sin(s), np.cos(theta) * np.cos(s), np.sin(theta) * np.cos(s)], axis=1)
     x, info = shapes.load_initial(write_points(tmp_path / f"circle.{suffix}", points), 6)
-    reference = initial.inclined_circle(6, theta)
+    reference = shapes.inclined_circle(6, theta)
     error = np.max(np.abs(x[:, 1:] - reference[:, 1:]))
     assert error < 1e-10, error  # measured 1.1e-15
     assert np.max(np.abs(x[:, 0] - centre / radius)) < 1e-10  # x_model = scale * x_file
@@ -100,8 +100,8 @@ def test_example_file_diagnostics_and_tail_warning(capsys):
 
 def test_perturbation_in_the_shapes_own_frame_matches_the_builtin():
     theta = np.radians(35.0)
-    mine = shapes.perturb(initial.inclined_circle(7, theta), 1e-3, seed=4)
-    assert np.max(np.abs(mine - initial.initial_shape(7, theta, 1e-3, seed=4))) < 1e-14
+    mine = shapes.perturb(shapes.inclined_circle(7, theta), 1e-3, seed=4)
+    assert np.max(np.abs(mine - shapes.initial_shape(7, theta, 1e-3, seed=4))) < 1e-14
 
 
 # ---- continuation from results -----------------------------------------------------
@@ -166,7 +166,7 @@ def test_sweep_results_and_cases_with_initial_column(tmp_path, capsys):
 
 
 def test_api_initial_arguments():
-    circle = initial.inclined_circle(5, 0.3)
+    circle = shapes.inclined_circle(5, 0.3)
     result = api.simulate(10, None, initial=circle, t_span=(0, 0.01))
     assert result.inputs["n"] == 5 and result.initial_info["kind"] == "coefficients"
     with pytest.raises(ValueError, match="theta0_deg must be None"):

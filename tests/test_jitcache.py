@@ -2,7 +2,7 @@
 import numba
 
 import loopsim
-from loopsim import _jitcache
+from loopsim import _jitcache  # noqa: the cache guard is tested as a unit
 
 
 def test_cache_directory_follows_the_source(tmp_path):
@@ -14,4 +14,8 @@ def test_cache_directory_follows_the_source(tmp_path):
     assert _jitcache.source_hash([str(a), str(b)]) != before
     assert numba.config.CACHE_DIR == _jitcache.cache_dir()
     assert numba.config.CACHE_DIR.endswith("numba-" + _jitcache.source_hash())
-    assert loopsim.batch._integrate_cases._cache._cache_path.startswith(numba.config.CACHE_DIR)
+    # subpackages count: an integrator or model edit must start a fresh cache
+    sources = _jitcache.package_sources()
+    assert any(p.endswith("integrators/driver.py") for p in sources)
+    assert any(p.endswith("models/local_sbt.py") for p in sources)
+    assert loopsim.batch.parallel_cases._cache._cache_path.startswith(numba.config.CACHE_DIR)

@@ -1,4 +1,4 @@
-"""Tests for loopsim.linear_stability against independent references.
+"""Tests for loopsim.stability.paper against independent references.
 
 References: direct quadrature of L[sin ks] (operator applied analytically on a
 grid of s), the paper's printed matrix and quoted critical values, sqrt(300)
@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pytest
 
-from loopsim.linear_stability import (
+from loopsim.stability.paper import (
     critical_q,
     critical_q_table,
     largest_growth_rate,

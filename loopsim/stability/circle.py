@@ -13,11 +13,10 @@ q = g0 sin θ0 / 3.  F is translation invariant, so in the co-moving frame a
 perturbation δ, x = x0 + u0 t + δ, obeys dδ/dt = J δ with J = dF/dx(x0).
 
 Jacobian.  :func:`rhs_jacobian` is the exact linearisation of the *discrete*
-maps (chain rule through the three maps and the least-squares tension solve,
-dT = -(AᵀA)⁻¹[Aᵀ(dA T + db) + dAᵀ r] for ε = A T + b, r = ε(T)), exact to
-round-off at any shape.  Central differences of ``loop_velocity``
-(:func:`rhs_jacobian_fd`) approach it as h² (1.4e-8 of max|J| at h = 1e-6,
-n = 6); Richardson-extrapolated ones agree to 4e-12 (n = 6) ... 3e-8 (n = 12).
+maps (``models.local_sbt.loop_jacobian``: chain rule through the three maps
+and the least-squares tension solve, dT = -(AᵀA)⁻¹[Aᵀ(dA T + db) + dAᵀ r] for
+ε = A T + b, r = ε(T)), exact to round-off at any shape; tested against an
+independent NumPy twin and finite differences in ``tests/``.
 
 Coordinates.  y = [P, R, Z]: the components of δ along a = e_x, b = [0, cos θ0,
 sin θ0] (the circle's plane, x0 = sin s a + cos s b) and e_n = [0, -sin θ0,
@@ -44,7 +43,7 @@ q.  The in-plane block further splits (again triangularly) into
   (truncation artefacts, strongly damped).  Neither is physical.
 
 The out-of-plane sector (2(n - 1) modes, ζ = Z of wavenumber 2..n) coincides
-with the corrected operator (:func:`corrected_operator`)
+with the corrected operator (``stability.paper``, ``corrected=True``)
 
     L = -∂⁴ - ∂² + q (sin s ∂ + cos s ∂²),
 
@@ -61,19 +60,19 @@ import functools
 import math
 
 import numpy as np
-from scipy.linalg import eig, eigh_tridiagonal
-from scipy.optimize import brentq
 
-from . import diagnostics, initial, linear_stability, physics, problems
-from .config import DEFAULT_W
+from .. import spectral, validation
+from ..config import DEFAULT_W
+from ..models import local_sbt
+from ..shapes import inclined_circle
+from . import paper
+from .roots import first_crossing
 
 __all__ = [
-    "SECTORS", "circle_velocity", "rhs_jacobian", "rhs_jacobian_fd", "sector_frame",
+    "SECTORS", "circle_velocity", "rhs_jacobian", "sector_frame",
     "neutral_modes", "neutral_mode_residuals", "CircleLinearisation", "linearise_circle",
-    "FullSpectrum", "full_spectrum", "free_ring_rates", "sector_growth_rates",
-    "critical_q", "critical_q_table", "corrected_operator", "corrected_critical_q",
-    "paper_comparison", "unstable_mode", "onset_q", "seeded_mode_amplitudes", "regime_onsets",
-    "comparison_figure",
+    "FullSpectrum", "full_spectrum", "free_ring_rates", "sector_growth_rates", "sigma",
+    "critical_q", "critical_q_table", "paper_comparison", "unstable_mode", "l2_weights",
 ]
 
 #: Physical sectors (labels of :class:`FullSpectrum`; also "stretch" and "neutral").
@@ -83,23 +82,19 @@ SECTORS = ("in-plane", "out-of-plane")
 # ---------------------------------------------------------------- helpers
 @functools.lru_cache(maxsize=32)
 def _operators(n):
-    return physics.make_operators(n)
+    return local_sbt.make_operators(n)
 
 
 def _check_n(n, low=3):
-    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < low:
-        raise ValueError(f"n must be an integer >= {low}, got {n!r}")
-    return int(n)
+    return validation.check_integer("n", n, low)
 
 
 def _check_theta_for_q(theta0_deg):
-    th = float(theta0_deg)
-    if not (0.0 < th <= 90.0):
-        raise ValueError(f"theta0 must be in (0, 90] degrees for a given q, got {theta0_deg!r}")
-    return th
+    return validation.check_tilt("theta0 (for a given q)", theta0_deg, allow_zero=False)
 
 
-def _check_sector(sector):
+def check_sector(sector):
+    """One of SECTORS."""
     if sector not in SECTORS:
         raise ValueError(f"sector must be one of {SECTORS}, got {sector!r}")
     return sector
@@ -110,7 +105,7 @@ def circle_velocity(g0, theta0):
     return -np.array([0.0, g0 * math.sin(2 * theta0) / 6.0, g0 * (7.0 - math.cos(2 * theta0)) / 6.0])
 
 
-def _l2_weights(n):
+def l2_weights(n):
     """Weights of the coefficient layout for ⟨f, g⟩ = (1/2π)∫ f g ds: [1, ½ ...]."""
     w = np.full(2 * n + 1, 0.5)
     w[0] = 1.0
@@ -119,93 +114,13 @@ def _l2_weights(n):
 
 # ---------------------------------------------------------------- Jacobian
 def rhs_jacobian(x, g0, w=DEFAULT_W):
-    """Exact Jacobian dF/dx (3K, 3K) of the spectral RHS at shape x (3, K).
-
-    Acts on x.ravel() (component-major).  Linearises, for each coordinate
-    direction δx, with t = x', κ = x'':
-      δf = P[T' δt + T δκ - δx''''] + P[δT' t + δT κ]
-      δm = δf + (δt·f + t·δf) t + (t·f) δt,      u = F m
-      δε = δt·(P1 m) + t·(P1 δm) + 2w t·δt
-    and the least-squares tension dT = -(AᵀA)⁻¹[Aᵀ δε|_T + dAᵀ r].
-    """
+    """Exact Jacobian dF/dx (3K, 3K) of the spectral RHS at shape x (3, K), acting on
+    x.ravel() (component-major): ``models.local_sbt.loop_jacobian``."""
     x = np.ascontiguousarray(x, dtype=float)
     n = (x.shape[1] - 1) // 2
-    K = 2 * n + 1
-    ops = _operators(n)
-    S0, S1, S2, S4, P, P1, F = ops.S0, ops.S1, ops.S2, ops.S4, ops.P, ops.P1, ops.F
-    M = ops.m
-    prob = problems.make_loop_problem(n, g0, w, ops)
-    u = np.empty_like(x)
-    physics.loop_velocity(x, prob.g0, prob.w, ops, prob.ws, u)
-    T = prob.ws.tension.copy()
-
-    t, kap, x4 = x @ S1.T, x @ S2.T, x @ S4.T                     # (3, M)
-    Tg, Tp = S0 @ T, S1 @ T
-    ez = np.array([0.0, 0.0, 1.0])[:, None]
-    f = (Tp * t + Tg * kap - x4 - g0 * ez) @ P.T
-    tf = np.sum(t * f, 0)
-    m = f + tf * t
-    dm_base = m @ P1.T
-    r = np.sum(t * dm_base, 0) - w * (1.0 - np.sum(t * t, 0))      # residual of the solve
-
-    # linear part A (M, K) of ε(T) = A T + b, column j for T = φ_j
-    fj = np.einsum("mi,ci,ij->mcj", P, t, S1) + np.einsum("mi,ci,ij->mcj", P, kap, S0)
-    tfj = np.einsum("cm,mcj->mj", t, fj)
-    mj = fj + tfj[:, None, :] * t.T[:, :, None]
-    dmj = np.einsum("mi,icj->mcj", P1, mj)
-    A = np.einsum("cm,mcj->mj", t, dmj)
-
-    # directions: unit vectors e_(c,k); δt[d] etc. (D, 3, M)
-    D = 3 * K
-    dt = np.zeros((3, K, 3, M))
-    dk = np.zeros((3, K, 3, M))
-    d4 = np.zeros((3, K, 3, M))
-    for c in range(3):
-        dt[c, :, c, :] = S1.T
-        dk[c, :, c, :] = S2.T
-        d4[c, :, c, :] = S4.T
-    dt, dk, d4 = (a.reshape(D, 3, M) for a in (dt, dk, d4))
-
-    df = (Tp * dt + Tg * dk - d4) @ P.T
-    dm = (df + (np.einsum("dcm,cm->dm", dt, f) + np.einsum("cm,dcm->dm", t, df))[:, None, :] * t
-          + tf * dt)
-    deps = (np.einsum("dcm,cm->dm", dt, dm_base) + np.einsum("cm,dcm->dm", t, dm @ P1.T)
-            + 2.0 * w * np.einsum("cm,dcm->dm", t, dt))
-
-    # dAᵀ r without forming dA: Σ_i r_i δε_ij with δε_ij = δt·(P1 m_j) + t·(P1 δm_j)
-    rho = (r * t) @ P1                                               # P1ᵀ(r t), (3, M)
-    rt = np.sum(rho * t, 0)
-    sig = (rho + rt * t) @ P                                         # Pᵀ(ρ + (ρ·t) t)
-    dAr = (np.einsum("dcm,cm->dm", dt, sig) @ S1 + np.einsum("dcm,cm->dm", dk, sig) @ S0
-           + np.einsum("dcm,mcj->dj", rt * dt, fj) + np.einsum("dm,mj->dj", np.einsum("cm,dcm->dm", rho, dt), tfj)
-           + np.einsum("dcm,mcj->dj", r * dt, dmj))
-
-    q_, r_ = np.linalg.qr(A)
-    dT = -np.linalg.solve(r_, q_.T @ deps.T)                         # (K, D)
-    dT -= np.linalg.solve(r_, np.linalg.solve(r_.T, dAr.T))
-    du = (dm + np.einsum("mcj,jd->dcm", mj, dT)) @ F.T               # (D, 3, K)
-    return du.reshape(D, D).T
-
-
-def rhs_jacobian_fd(x, g0, w=DEFAULT_W, h=1e-6):
-    """Central finite differences (F(x + h e) - F(x - h e)) / 2h of the RHS.
-
-    Error ~ h² |F'''| / 6 + ε_mach |F| / h: 1.4e-8 (n = 6) to 9e-7 (n = 12) of
-    max|J| at h = 1e-6.  For tests; :func:`rhs_jacobian` is exact.
-    """
-    x = np.ascontiguousarray(x, dtype=float)
-    n = (x.shape[1] - 1) // 2
-    ops = _operators(n)
-    prob = problems.make_loop_problem(n, g0, w, ops)
-    D = x.size
-    jac = np.empty((D, D))
-    up, um = np.empty_like(x), np.empty_like(x)
-    for i in range(D):
-        e = np.zeros(D)
-        e[i] = h
-        physics.loop_velocity(x + e.reshape(x.shape), prob.g0, prob.w, ops, prob.ws, up)
-        physics.loop_velocity(x - e.reshape(x.shape), prob.g0, prob.w, ops, prob.ws, um)
-        jac[:, i] = ((up - um) / (2.0 * h)).ravel()
+    problem = local_sbt.make_problem(n, g0, w, _operators(n))
+    jac = np.empty((x.size, x.size))
+    local_sbt.loop_jacobian(x, problem.g0, problem.w, problem.ops, problem.ws, jac)
     return jac
 
 
@@ -298,7 +213,7 @@ def linearise_circle(n, g0, theta0_deg, w=DEFAULT_W):
     n = _check_n(n)
     th = math.radians(theta0_deg)
     K = 2 * n + 1
-    J = rhs_jacobian(initial.inclined_circle(n, th), g0, w)
+    J = rhs_jacobian(inclined_circle(n, th), g0, w)
     R = sector_frame(n, th)
     Jy = R.T @ J @ R
     qp, qs, qo = _bases(n)
@@ -337,7 +252,7 @@ def neutral_mode_residuals(n, g0, theta0_deg, w=DEFAULT_W):
     n = _check_n(n)
     th = math.radians(theta0_deg)
     K = 2 * n + 1
-    J = rhs_jacobian(initial.inclined_circle(n, th), g0, w)
+    J = rhs_jacobian(inclined_circle(n, th), g0, w)
     V = neutral_modes(n, theta0_deg)
     out = []
     for name, v in zip(NEUTRAL_NAMES, V.T):
@@ -396,7 +311,7 @@ def full_spectrum(g0, theta0_deg, n, w=DEFAULT_W):
     """All 3K eigenvalues of J at the circle (g0, θ0), labelled by sector; see :class:`FullSpectrum`."""
     lin = linearise_circle(n, g0, theta0_deg, w)
     K = 2 * lin.n + 1
-    wts = np.tile(_l2_weights(lin.n), 3)
+    wts = np.tile(l2_weights(lin.n), 3)
     frame = sector_frame(lin.n, math.radians(theta0_deg))
     vals, labels, vecs, frac = [], [], [], []
     offset = 0
@@ -435,7 +350,7 @@ def free_ring_rates(n, sector):
     tension perturbation fixed by δu_r + δu_t' = 0.
     """
     n = _check_n(n)
-    if _check_sector(sector) == "out-of-plane":
+    if check_sector(sector) == "out-of-plane":
         k = np.arange(2, n + 1, dtype=float)
         rates = -k**2 * (k**2 - 1.0)
     else:
@@ -453,7 +368,8 @@ def _pencil(n, theta0_deg, w):
     return {s: (lin0.blocks[s], lin1.blocks[s] - lin0.blocks[s]) for s in SECTORS + ("stretch",)}
 
 
-def _sigma(n, theta0_deg, w, sector, q):
+def sigma(n, theta0_deg, w, sector, q):
+    """Largest Re σ of a sector's block at q (from the affine pencil, :func:`sector_growth_rates`)."""
     b0, b1 = _pencil(n, theta0_deg, w)[sector]
     return float(np.max(np.linalg.eigvals(b0 + q * b1).real))
 
@@ -467,7 +383,7 @@ def sector_growth_rates(q_values, n, theta0_deg=90.0, w=DEFAULT_W):
     n = _check_n(n)
     th = _check_theta_for_q(theta0_deg)
     qs = np.asarray(q_values, dtype=float)
-    return {s: np.array([_sigma(n, th, float(w), s, float(q)) for q in qs.ravel()]).reshape(qs.shape)
+    return {s: np.array([sigma(n, th, float(w), s, float(q)) for q in qs.ravel()]).reshape(qs.shape)
             for s in SECTORS + ("stretch",)}
 
 
@@ -477,76 +393,26 @@ def critical_q(n, sector, theta0_deg=90.0, w=DEFAULT_W, q_max=60.0, q_step=0.5):
     NaN if there is no crossing on [0, q_max].
     """
     n = _check_n(n)
-    _check_sector(sector)
+    check_sector(sector)
     th = _check_theta_for_q(theta0_deg)
-    fun = functools.partial(_sigma, n, th, float(w), sector)
-    q_lo, f_lo = 0.0, fun(0.0)
-    for q_hi in np.arange(q_step, q_max + q_step / 2, q_step):
-        f_hi = fun(q_hi)
-        if f_hi >= 0.0 > f_lo:
-            return float(brentq(fun, q_lo, q_hi, xtol=1e-13, rtol=4 * np.finfo(float).eps, maxiter=200))
-        q_lo, f_lo = q_hi, f_hi
-    return float("nan")
+    return first_crossing(functools.partial(sigma, n, th, float(w), sector), q_max, q_step, 1e-13)
 
 
 def critical_q_table(n_values, theta0_deg=90.0, w=DEFAULT_W):
     """Rows (n, q_crit in-plane, q_crit out-of-plane, paper's q_crit, corrected-operator q_crit)."""
     return [(int(n), critical_q(n, "in-plane", theta0_deg, w), critical_q(n, "out-of-plane", theta0_deg, w),
-             linear_stability.critical_q(int(n)), corrected_critical_q(int(n))) for n in n_values]
+             paper.critical_q(int(n)), paper.critical_q(int(n), corrected=True)) for n in n_values]
 
 
-# ---------------------------------------------------------------- the paper's operator, corrected
-def corrected_operator(q, n):
-    """Matrix of L = -∂⁴ - ∂² + q(sin s ∂ + cos s ∂²) on span{sin ks, k = 2..n}.
-
-    L[sin ks] = -(k⁴ - k²) sin ks - q k(k+1)/2 sin(k-1)s - q k(k-1)/2 sin(k+1)s;
-    sin s is an exact null vector (a rigid rotation) and is left out.  The
-    cos ks span gives the same matrix after the quotient by the translation.
-    Column k - 2 is the image of sin ks.
-    """
-    n = _check_n(n)
-    k = np.arange(2, n + 1, dtype=float)
-    m = np.diag(-(k**4 - k**2))
-    for i, kk in enumerate(k):
-        if i > 0:
-            m[i - 1, i] = -q * kk * (kk + 1.0) / 2.0
-        if i < len(k) - 1:
-            m[i + 1, i] = -q * kk * (kk - 1.0) / 2.0
-    return m
-
-
-def _corrected_sigma(n, q):
-    """Largest eigenvalue of corrected_operator(q, n), from its symmetric tridiagonal form
-    (off-diagonal products q²(k-1)k(k+1)(k+2)/4 ≥ 0, as in linear_stability)."""
-    k = np.arange(2, n + 1, dtype=float)
-    d = -(k**4 - k**2)
-    km = k[:-1]
-    e = -0.5 * abs(q) * np.sqrt((km - 1.0) * km * (km + 1.0) * (km + 2.0))
-    return float(eigh_tridiagonal(d, e, eigvals_only=True, select="i",
-                                  select_range=(len(d) - 1, len(d) - 1),
-                                  tol=2.0 * np.finfo(float).tiny)[0])
-
-
-def corrected_critical_q(n, q_max=100.0):
-    """Critical q of :func:`corrected_operator` (symmetrised, as in linear_stability); NaN if none."""
-    n = _check_n(n)
-    fun = functools.partial(_corrected_sigma, n)
-    grid = np.arange(0.0, q_max + 0.5, 0.5)
-    vals = [fun(q) for q in grid]
-    for i in range(1, len(grid)):
-        if vals[i] >= 0.0 > vals[i - 1]:
-            return float(brentq(fun, grid[i - 1], grid[i], xtol=1e-14, rtol=4 * np.finfo(float).eps))
-    return float("nan")
-
-
+# ---------------------------------------------------------------- comparison with the paper
 def paper_comparison(q_values, n, theta0_deg=90.0, w=DEFAULT_W):
     """Rows dict(q, paper, corrected, out_of_plane, in_plane): largest growth rates of the
     paper's operator (linear_stability), the corrected operator, and the full Jacobian's sectors."""
     rates = sector_growth_rates(q_values, n, theta0_deg, w)
     rows = []
     for i, q in enumerate(np.asarray(q_values, dtype=float).ravel()):
-        rows.append(dict(q=float(q), paper=linear_stability.largest_growth_rate(float(q), n),
-                         corrected=_corrected_sigma(n, float(q)),
+        rows.append(dict(q=float(q), paper=paper.largest_growth_rate(float(q), n),
+                         corrected=paper.largest_growth_rate(float(q), n, corrected=True),
                          out_of_plane=float(rates["out-of-plane"].ravel()[i]),
                          in_plane=float(rates["in-plane"].ravel()[i])))
     return rows
@@ -568,7 +434,7 @@ def unstable_mode(q, n, sector, theta0_deg=90.0, w=DEFAULT_W, points=256):
     loop, N = +q; s = π the bottom (fore), N = -q.
     """
     n = _check_n(n)
-    _check_sector(sector)
+    check_sector(sector)
     th = math.radians(_check_theta_for_q(theta0_deg))
     g0 = 3.0 * q / math.sin(th)
     spec = full_spectrum(g0, theta0_deg, n, w)
@@ -578,7 +444,7 @@ def unstable_mode(q, n, sector, theta0_deg=90.0, w=DEFAULT_W, points=256):
     vecs = np.concatenate([np.stack([v.real, v.imag]) if np.any(v.imag) else v.real[None]
                            for v in spec.modes[group]]).reshape(-1, 3 * (2 * n + 1))
     # L²-orthonormal basis of the eigenspace
-    wts = np.sqrt(np.tile(_l2_weights(n), 3))
+    wts = np.sqrt(np.tile(l2_weights(n), 3))
     qv, rv = np.linalg.qr((vecs * wts).T)
     qv = qv[:, np.abs(np.diag(rv)) > 1e-10 * np.abs(rv).max()]
     basis = (qv.T / wts).reshape(-1, 3, 2 * n + 1)
@@ -587,7 +453,7 @@ def unstable_mode(q, n, sector, theta0_deg=90.0, w=DEFAULT_W, points=256):
                       [0.0, -math.sin(th), math.cos(th)]])
     e_r = np.outer(frame[0], np.sin(s)) + np.outer(frame[1], np.cos(s))
     e_t = np.outer(frame[0], np.cos(s)) - np.outer(frame[1], np.sin(s))
-    vals = np.stack([b @ _synthesis(n, s).T for b in basis])         # (B, 3, points)
+    vals = np.stack([b @ spectral.basis(n, s).T for b in basis])         # (B, 3, points)
     zeta = np.einsum("c,bcs->bs", frame[2], vals)
     alpha = np.einsum("cs,bcs->bs", e_r, vals)
     beta = np.einsum("cs,bcs->bs", e_t, vals)
@@ -607,177 +473,3 @@ def unstable_mode(q, n, sector, theta0_deg=90.0, w=DEFAULT_W, points=256):
                      if np.sum(alpha**2 + beta**2) > 1e-20 * np.sum(vals**2) else float("nan")),
         normal_fraction=float(np.sum(zeta**2) / np.sum(vals**2)),
     )
-
-
-def _synthesis(n, s):
-    k = np.arange(1, n + 1)
-    return np.concatenate((np.ones((s.size, 1)), np.cos(np.outer(s, k)), np.sin(np.outer(s, k))), axis=1)
-
-
-# ---------------------------------------------------------------- onset of visible regimes
-def onset_q(eps, t_end, detect, n, sector, theta0_deg=90.0, w=DEFAULT_W, q_max=60.0):
-    """q at which a mode of initial size eps reaches size detect at t_end:
-    eps·exp(σ(q) t_end) = detect, i.e. σ(q) = ln(detect/eps)/t_end.  NaN if never on [0, q_max].
-    """
-    if not (eps > 0 and detect > 0 and t_end > 0):
-        raise ValueError("eps, detect and t_end must be positive")
-    n = _check_n(n)
-    _check_sector(sector)
-    th = _check_theta_for_q(theta0_deg)
-    target = math.log(detect / eps) / t_end
-    fun = lambda q: _sigma(n, th, float(w), sector, q) - target  # noqa: E731
-    q_lo, f_lo = 0.0, fun(0.0)
-    if f_lo >= 0.0:
-        return 0.0
-    for q_hi in np.arange(0.5, q_max + 0.25, 0.5):
-        f_hi = fun(q_hi)
-        if f_hi >= 0.0:
-            return float(brentq(fun, q_lo, q_hi, xtol=1e-12))
-        q_lo, f_lo = q_hi, f_hi
-    return float("nan")
-
-
-def _observable_gains(q, n, theta0_deg, w):
-    """Linear gains of the sweep's observables per unit rms amplitude of the leading modes.
-
-    c_aspect: max over the in-plane eigenspace of |d(aspect ratio)/dA| at the circle.
-    c_tilt: max over the out-of-plane eigenspace (amplitude = rms of ζ) of the rate of
-    rigid rotation about the horizontal axis a (dθ/dt per unit amplitude), read off
-    J v - σ v ∈ N: the k = 2 normal mode drives the k = 1 tilt (the -3q coupling).
-    """
-    th = math.radians(theta0_deg)
-    g0 = 3.0 * q / math.sin(th)
-    spec = full_spectrum(g0, theta0_deg, n, w)
-    lin = linearise_circle(n, g0, theta0_deg, w)
-    x0 = initial.inclined_circle(n, th)
-    nx = neutral_modes(n, theta0_deg)
-    wts = _l2_weights(n)
-    gains = {}
-    for sector in SECTORS:
-        sel = np.flatnonzero(spec.sector == sector)[:2]
-        lam = spec.eigenvalues[sel[0]].real
-        best = 0.0
-        for phi in np.linspace(0.0, np.pi, 37):
-            v = math.cos(phi) * spec.modes[sel[0]].real + math.sin(phi) * spec.modes[sel[-1]].real
-            if sector == "in-plane":
-                v = v / math.sqrt(np.sum(wts * v**2))
-                h = 1e-7
-                best = max(best, abs(diagnostics.aspect_ratio(x0 + h * v) - 1.0) / h)
-            else:
-                zeta = (-math.sin(th)) * v[1] + math.cos(th) * v[2]
-                v = v / math.sqrt(np.sum(wts * zeta**2))
-                r = lin.jacobian @ v.ravel() - lam * v.ravel()
-                best = max(best, abs(np.linalg.lstsq(nx, r, rcond=None)[0][4]))
-        gains[sector] = best
-    return gains["in-plane"], gains["out-of-plane"]
-
-
-def seeded_mode_amplitudes(eps, seed, n, theta0_deg, w=DEFAULT_W):
-    """Rms amplitudes that ``initial.initial_shape(n, θ0, eps, seed)`` puts into the leading
-    in-plane eigenspace (its |δ|) and the leading out-of-plane one (its ζ), each taken at
-    the sector's critical q, via the spectral projector V (WᴴV)⁻¹ Wᴴ of the quotient J̄
-    (right and left eigenvectors of the double eigenvalue).
-    """
-    n = _check_n(n, 3)
-    th = math.radians(_check_theta_for_q(theta0_deg))
-    x0 = initial.inclined_circle(n, th)
-    d = (initial.initial_shape(n, th, eps, seed) - x0).ravel()
-    wts = np.tile(_l2_weights(n), 3)
-    amps = {}
-    for sector in SECTORS:
-        qc = critical_q(n, sector, theta0_deg, w)
-        lin = linearise_circle(n, 3.0 * qc / math.sin(th), theta0_deg, w)
-        vals, left, right = eig(lin.quotient, left=True, right=True)
-        lead = np.max(np.linalg.eigvals(lin.blocks[sector]).real)
-        pick = np.argsort(np.abs(vals - lead))[:2]
-        V, W = right[:, pick], left[:, pick]
-        coords = lin.basis.T @ d                               # d in quotient coordinates
-        proj = lin.basis @ (V @ np.linalg.solve(W.conj().T @ V, W.conj().T @ coords))
-        proj = proj.real.reshape(3, -1)
-        if sector == "out-of-plane":
-            proj = (-math.sin(th) * proj[1] + math.cos(th) * proj[2])[None]
-        amps[sector] = float(math.sqrt(np.sum(wts[:proj.shape[1]] * proj**2)))
-    return amps["in-plane"], amps["out-of-plane"]
-
-
-def regime_onsets(eps=1e-3, t_end=10.0, n=6, theta0_deg=90.0, w=DEFAULT_W,
-                  aspect_tol=0.01, tilt_tol_deg=1.0, saturation=0.5, seed=None):
-    """Predicted q where loops released with perturbation size eps are first labelled
-    in-plane and 3D at t_end (the sweep's thresholds), from the circle's growth rates.
-
-    Each leading mode starts with rms amplitude eps (ζ's rms for the out-of-plane one).
-    In-plane: the aspect ratio changes by c_aspect·A (A = eps·e^{σ_in t}); visible when
-    c_aspect·eps·e^{σ_in t_end} = aspect_tol.
-    3D: the out-of-plane mode turns the loop about its horizontal axis at rate c_tilt·A,
-    so Δθ(t) = c_tilt·eps·(e^{σ_out t} - 1)/σ_out; growth about the circle stops once the
-    in-plane mode saturates (aspect change ``saturation``, reached at
-    t_sat = ln(saturation/(c_aspect eps))/σ_in), so Δθ is taken at min(t_end, t_sat).
-    With ``seed`` given, the amplitudes are those the seeded initial perturbation of size
-    eps puts into the two leading eigenspaces (:func:`seeded_mode_amplitudes`) instead
-    of eps.  Gains from :func:`_observable_gains` at each sector's critical q.  The 3D onset of
-    the circle is a lower bound: beyond it the saturated in-plane shape has its own
-    instability (docs/stability.md).  Returns a dict.
-    """
-    n = _check_n(n, 3)
-    th = _check_theta_for_q(theta0_deg)
-    if not (eps > 0 and t_end > 0 and aspect_tol > 0 and tilt_tol_deg > 0 and saturation > aspect_tol):
-        raise ValueError("eps, t_end and the tolerances must be positive, saturation > aspect_tol")
-    qc_in, qc_out = critical_q(n, "in-plane", th, w), critical_q(n, "out-of-plane", th, w)
-    c_aspect, _ = _observable_gains(qc_in, n, th, w)
-    _, c_tilt = _observable_gains(qc_out, n, th, w)
-    tilt_tol = math.radians(tilt_tol_deg)
-    a_in, a_out = (eps, eps) if seed is None else seeded_mode_amplitudes(eps, seed, n, th, w)
-
-    def f_in(q):
-        return math.log(c_aspect * a_in / aspect_tol) + _sigma(n, th, float(w), "in-plane", q) * t_end
-
-    def f_out(q):
-        s_in = _sigma(n, th, float(w), "in-plane", q)
-        t = t_end if s_in <= 0 else min(t_end, math.log(saturation / (c_aspect * a_in)) / s_in)
-        s_out = _sigma(n, th, float(w), "out-of-plane", q)
-        growth = math.expm1(s_out * t) / s_out if s_out != 0.0 else t
-        return c_tilt * a_out * growth - tilt_tol
-
-    out = {}
-    for key, fun in (("q_in_plane", f_in), ("q_3d", f_out)):
-        grid = np.arange(0.0, 60.0, 0.25)
-        vals = [fun(q) for q in grid]
-        hit = next((k for k in range(1, len(grid)) if vals[k] >= 0.0 > vals[k - 1]), None)
-        out[key] = float("nan") if hit is None else float(brentq(fun, grid[hit - 1], grid[hit], xtol=1e-10))
-    out.update(c_aspect=float(c_aspect), c_tilt=float(c_tilt), amplitude_in_plane=a_in,
-               amplitude_out_of_plane=a_out, q_crit_in_plane=qc_in,
-               q_crit_out_of_plane=qc_out)
-    return out
-
-
-# ---------------------------------------------------------------- figure
-def comparison_figure(path, n=16, q_values=None, theta0_deg=90.0, w=DEFAULT_W):
-    """Largest growth rates vs q: paper's operator, corrected operator, both sectors of J."""
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    q_values = np.linspace(0.0, 20.0, 81) if q_values is None else np.asarray(q_values, float)
-    rows = paper_comparison(q_values, n, theta0_deg, w)
-    fig, ax = plt.subplots(figsize=(6.4, 4.2))
-    get = lambda key: [r[key] for r in rows]  # noqa: E731
-    ax.plot(q_values, get("paper"), "k--", label="paper's operator (§4)")
-    ax.plot(q_values, get("out_of_plane"), "C0-", lw=2, label="full J, out-of-plane")
-    ax.plot(q_values, get("corrected"), "C1:", lw=1.5, label="corrected operator")
-    ax.plot(q_values, get("in_plane"), "C3-", lw=2, label="full J, in-plane")
-    ax.axhline(0.0, color="0.6", lw=0.8)
-    for sector, color in (("in-plane", "C3"), ("out-of-plane", "C0")):
-        qc = critical_q(n, sector, theta0_deg, w)
-        ax.axvline(qc, color=color, lw=0.8, ls="--")
-        ax.annotate(f"{qc:.4f}", (qc, -14), color=color, rotation=90, ha="right", va="bottom")
-    qp = linear_stability.critical_q(n)
-    ax.annotate(f"{qp:.4f}", (qp, -14), color="k", rotation=90, ha="right", va="bottom")
-    ax.set_ylim(-15, 15)
-    ax.set_xlabel("q = g0 sin θ0 / 3")
-    ax.set_ylabel("largest growth rate σ")
-    ax.set_title(f"translating circle, n = {n}")
-    ax.legend(frameon=False)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path

@@ -1,4 +1,6 @@
-"""The loop's equations of motion as three affine maps (paper §5), in Numba.
+"""Local slender-body theory: the loop's equations of motion as three affine maps (paper §5).
+
+The first model of ``loopsim.models`` (problem type :class:`LoopProblem`).
 
     T --(1) Euler–Bernoulli--> f --(2) local SBT--> u --(3) inextensibility--> ε
 
@@ -24,8 +26,11 @@ import collections
 import numba
 import numpy as np
 
-from . import spectral
-from .config import JIT
+from .. import spectral
+from ..config import JIT
+from .base import (
+    auxiliary, constraint_error, for_case, implements, jacobian, rhs, steady_invariants,
+)
 
 #: Precomputed constant matrices of one truncation order, shared by all cases.
 #: S0, S1, S2, S4: (M, K) synthesis of the value and 1st/2nd/4th derivative;
@@ -213,11 +218,33 @@ def relative_length_error(x, ops, ws):
 
 
 @numba.njit(**JIT)
+def shape_invariants(x):
+    """Covariance eigenvalues (size and shape; invariant under rigid motions and
+    arc-length shifts) and |n_z| of the best-fit plane's normal (the tilt), as one array.
+
+    C = ½ Σ_k (a_k a_kᵀ + b_k b_kᵀ) over the modes k ≥ 1 (``diagnostics.covariance``).
+    """
+    k = x.shape[1]
+    cov = np.zeros((3, 3))
+    for a in range(3):
+        for b in range(3):
+            acc = 0.0
+            for j in range(1, k):
+                acc += x[a, j] * x[b, j]
+            cov[a, b] = 0.5 * acc
+    values, vectors = np.linalg.eigh(cov)
+    out = np.empty(4)
+    out[:3] = values
+    out[3] = abs(vectors[2, 0])
+    return out
+
+
+@numba.njit(**JIT)
 def loop_jacobian(x, g0, w, ops, ws, jac):
     """Exact Jacobian J = ∂u/∂x (3K × 3K, component-major) of :func:`loop_velocity`.
 
     The chain rule through the three maps and the least-squares tension
-    (derivation: docs/stability.md §1; NumPy twin: ``full_stability.rhs_jacobian``).
+    (derivation: docs/stability.md §1; tested against a NumPy twin in tests/naive.py).
     For the coordinate direction δx = e_c φ_k (δt = e_c φ_k', δκ = e_c φ_k''):
 
         δf = P[T' δt + T δκ − δx''''],   δm = δf + (δt·f + t·δf) t + (t·f) δt,
@@ -331,3 +358,64 @@ def loop_jacobian(x, g0, w, ops, ws, jac):
         for kk in range(k):
             for col in range(d):
                 jac[cc * k + kk, col] = du[kk, cc, col]
+
+
+# ---- the model interface (models.base) --------------------------------------
+#: The problem: parameters g0 (gravity over stiffness) and w (length-penalty rate),
+#: the operators of one truncation order (shared) and a per-case workspace.
+#: State y = x.ravel(), x the (3, 2n+1) position coefficients; dy/dt = u.
+LoopProblem = collections.namedtuple("LoopProblem", "g0 w ops ws")
+#: Order of the per-case parameters passed to ``for_case``.
+PARAMETERS = ("g0", "w")
+
+
+def make_problem(n, g0, w, ops=None):
+    """Loop problem at truncation n (operators shared when given)."""
+    ops = make_operators(n) if ops is None else ops
+    return LoopProblem(float(g0), float(w), ops, make_workspace(n))
+
+
+def state_size(n):
+    """Length of the flat state vector: 3 (2n + 1)."""
+    return 3 * spectral.n_coeffs(n)
+
+
+@implements(rhs, LoopProblem)
+def _loop_rhs(problem, y, dydt):
+    k = y.shape[0] // 3
+    loop_velocity(y.reshape((3, k)), problem.g0, problem.w, problem.ops, problem.ws,
+                  dydt.reshape((3, k)))
+
+
+@implements(jacobian, LoopProblem)
+def _loop_jacobian(problem, y, f, jac, work_y, work_f):
+    k = y.shape[0] // 3
+    loop_jacobian(y.reshape((3, k)), problem.g0, problem.w, problem.ops, problem.ws, jac)
+    return 1  # one velocity evaluation inside
+
+
+@implements(constraint_error, LoopProblem)
+def _loop_length_error(problem, y):
+    k = y.shape[0] // 3
+    return relative_length_error(y.reshape((3, k)), problem.ops, problem.ws)
+
+
+@implements(steady_invariants, LoopProblem)
+def _loop_invariants(problem, y):
+    k = y.shape[0] // 3
+    return shape_invariants(y.reshape((3, k)))
+
+
+@implements(auxiliary, LoopProblem)
+def _loop_multiplier(problem, out):
+    out[:] = problem.ws.tension
+
+
+def constants(problem):
+    """What every case of one truncation shares: the operators."""
+    return problem.ops
+
+
+@implements(for_case, LoopOperators)
+def _loop_for_case(ops, parameters):
+    return LoopProblem(parameters[0], parameters[1], ops, make_workspace(ops.n))

@@ -1,0 +1,39 @@
+"""The integrator interface: the three method-specific pieces the driver calls.
+
+A *method* is a namedtuple type (its coefficients and policy constants, with
+an ``error_order`` field) plus njit implementations of these generic
+functions, registered with ``@implements(generic, MethodType)``
+(``loopsim.dispatch``).  The driver (``integrators.driver``) owns everything
+else: output times, step budget, monitors, statuses.
+"""
+from ..dispatch import generic, implements  # noqa: F401 - implements is re-exported
+
+
+@generic
+def start(method, problem, y, f, options):
+    """Workspace of the method for state size y.size, after any start-up work at y
+    (f = F(y)); returns (workspace, RHS evaluations spent)."""
+    raise NotImplementedError("only callable from jitted code")
+
+
+@generic
+def attempt(method, work, problem, y, f, h, y_new, options):
+    """Attempt one step of size h from y (f = F(y)): y_new and the verdict.
+
+    Returns (accepted, h_next, RHS evaluations): h_next is the step to retry
+    with after a rejection, or the proposal after an acceptance.
+    """
+    raise NotImplementedError("only callable from jitted code")
+
+
+@generic
+def advance(method, work, problem, y, f, h, h_proposal):
+    """Bookkeeping after an accepted step of size h that ended at y (f = F(y)):
+    returns (next step size, RHS evaluations spent)."""
+    raise NotImplementedError("only callable from jitted code")
+
+
+@generic
+def statistics(method, work):
+    """(Jacobian evaluations, LU factorisations) made so far by the method."""
+    raise NotImplementedError("only callable from jitted code")

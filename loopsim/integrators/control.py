@@ -1,0 +1,207 @@
+"""What every integrator shares: statuses, options, error norm, step-size control, output.
+
+Nothing here knows a method: the driver (``integrators.driver``) calls these
+helpers around one method-specific step attempt.
+
+Error control follows scipy's ``solve_ivp``: the error estimate err of a step
+from y to y_new is accepted when
+
+    ||err||_rms = sqrt(mean((err_i / (atol + rtol max(|y_i|, |y_new_i|)))²)) ≤ 1,
+
+and the next step is h · clip(SAFETY ||err||^(-1/(p+1)), MIN_FACTOR, MAX_FACTOR)
+with p the order of the error estimate.
+"""
+import collections
+
+import numba
+import numpy as np
+
+from ..config import JIT
+from ..models import constraint_error, rhs, steady_invariants
+
+# ---- status codes: the driver never raises; a run ends with one of these ----
+OK = 0
+STEP_BUDGET = 1
+STEP_UNDERFLOW = 2
+NON_FINITE = 3
+LENGTH_ERROR = 4
+STEADY = 5  # success: stopped early in a steady terminal state
+SUCCESS = (OK, STEADY)
+STATUS_NAMES = {
+    OK: "ok",
+    STEP_BUDGET: "step budget exhausted",
+    STEP_UNDERFLOW: "step size underflow",
+    NON_FINITE: "non-finite state",
+    LENGTH_ERROR: "length error too large",
+    STEADY: "ok",
+}
+#: Why a run stopped, per status.
+STOP_REASONS = {**STATUS_NAMES, OK: "t_end", STEADY: "steady"}
+
+# ---- step-size controller (the constants of scipy.integrate.RK45) ----------
+SAFETY = 0.9
+MIN_FACTOR = 0.2
+MAX_FACTOR = 10.0
+#: Relative stretch of a step allowed rather than leave a sliver before an output time.
+LANDING_STRETCH = 1e-8
+#: Consecutive quiet check intervals that make a steady state.
+STEADY_WINDOWS = 2
+
+StepOptions = collections.namedtuple(
+    "StepOptions",
+    "rtol atol first_step min_step max_step max_steps constraint_tol steady_interval steady_tol",
+)
+
+
+def step_options(rtol, atol, first_step=None, min_step=0.0, max_step=np.inf,
+                 max_steps=1_000_000, constraint_tol=np.inf, steady_interval=0.0,
+                 steady_tol=0.0):
+    """Driver options (scipy names where they exist) as a ``StepOptions`` tuple.
+
+    first_step: None selects the starting step automatically.
+    constraint_tol: stop with LENGTH_ERROR once |constraint_error| exceeds it.
+    steady_interval, steady_tol: at the first accepted step at least
+    ``steady_interval`` after the previous check, compare the model's
+    invariants (``models.steady_invariants``) with their values there; when
+    no invariant changed by more than ``steady_tol`` per ``steady_interval``
+    (the change is scaled by steady_interval / elapsed time, so long implicit
+    steps are judged like short ones) at STEADY_WINDOWS consecutive checks,
+    stop with status STEADY.  steady_interval <= 0 disables the check.
+    """
+    return StepOptions(float(rtol), float(atol), -1.0 if first_step is None else float(first_step),
+                       float(min_step), float(max_step), int(max_steps), float(constraint_tol),
+                       float(steady_interval), float(steady_tol))
+
+
+@numba.njit(**JIT)
+def rms_norm(v, scale):
+    """sqrt(mean((v_i / scale_i)²))."""
+    acc = 0.0
+    for i in range(v.shape[0]):
+        acc += (v[i] / scale[i]) ** 2
+    return np.sqrt(acc / v.shape[0])
+
+
+@numba.njit(**JIT)
+def error_scale(y, y_new, rtol, atol, scale):
+    """scale_i = atol + rtol max(|y_i|, |y_new_i|), written into ``scale``."""
+    for i in range(y.shape[0]):
+        scale[i] = atol + rtol * max(abs(y[i]), abs(y_new[i]))
+
+
+@numba.njit(**JIT)
+def step_factor(err_norm, error_order):
+    """Step-size factor SAFETY err^(-1/(p+1)), clipped to [MIN_FACTOR, MAX_FACTOR]."""
+    if err_norm == 0.0:
+        return MAX_FACTOR
+    if not np.isfinite(err_norm):
+        return MIN_FACTOR
+    return min(MAX_FACTOR, max(MIN_FACTOR, SAFETY * err_norm ** (-1.0 / (error_order + 1))))
+
+
+@numba.njit(**JIT)
+def all_finite(a):
+    for v in a.flat:
+        if not np.isfinite(v):
+            return False
+    return True
+
+
+@numba.njit(**JIT)
+def max_abs_difference(a, b):
+    worst = 0.0
+    for i in range(a.shape[0]):
+        worst = max(worst, abs(a[i] - b[i]))
+    return worst
+
+
+@numba.njit(**JIT)
+def initial_step(problem, y0, f0, f1, rtol, atol, error_order, h_max):
+    """Starting step by the Hairer–Nørsett–Wanner heuristic (as scipy's); f1 is scratch.
+
+    Costs one right-hand-side evaluation.
+    """
+    ny = y0.shape[0]
+    d0 = 0.0
+    d1 = 0.0
+    for i in range(ny):
+        scale = atol + rtol * abs(y0[i])
+        d0 += (y0[i] / scale) ** 2
+        d1 += (f0[i] / scale) ** 2
+    d0 = np.sqrt(d0 / ny)
+    d1 = np.sqrt(d1 / ny)
+    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
+    y1 = y0 + h0 * f0
+    rhs(problem, y1, f1)
+    d2 = 0.0
+    for i in range(ny):
+        scale = atol + rtol * abs(y0[i])
+        d2 += ((f1[i] - f0[i]) / scale) ** 2
+    d2 = np.sqrt(d2 / ny) / h0
+    if d1 <= 1e-15 and d2 <= 1e-15:
+        h1 = max(1e-6, h0 * 1e-3)
+    else:
+        h1 = (0.01 / max(d1, d2)) ** (1.0 / (error_order + 1))
+    return min(100.0 * h0, h1, h_max)
+
+
+# ---- output times and monitors ----------------------------------------------
+@numba.njit(**JIT)
+def record_start(problem, y, t0, t_out, y_out, options):
+    """Outputs at t0 and the initial monitor state (i_out, next_check, invariants, quiet)."""
+    i_out = 0
+    while i_out < t_out.shape[0] and t_out[i_out] <= t0:
+        y_out[i_out] = y
+        i_out += 1
+    return i_out, t0 + options.steady_interval, steady_invariants(problem, y), 0
+
+
+@numba.njit(**JIT)
+def landing(t, h, t_end, t_out, i_out):
+    """Step to try from t: h, shortened to land exactly on the next output time or t_end
+    (or stretched by up to LANDING_STRETCH rather than leave a sliver).
+
+    Returns (h_try, clipped, t_stop).
+    """
+    t_stop = t_end
+    if i_out < t_out.shape[0] and t_out[i_out] < t_stop:
+        t_stop = t_out[i_out]
+    if t + h * (1.0 + LANDING_STRETCH) >= t_stop:
+        return t_stop - t, True, t_stop
+    return h, False, t_stop
+
+
+@numba.njit(**JIT)
+def monitor(problem, t, y, t_end, t_out, y_out, options, i_out, worst, next_check, previous,
+            quiet):
+    """After an accepted step: constraint error, outputs, steady state.
+
+    Returns (status or -1 to go on, i_out, worst, next_check, previous, quiet).
+    """
+    worst = max(worst, abs(constraint_error(problem, y)))
+    if worst > options.constraint_tol:
+        return LENGTH_ERROR, i_out, worst, next_check, previous, quiet
+    while i_out < t_out.shape[0] and t_out[i_out] <= t:
+        y_out[i_out] = y
+        i_out += 1
+    if options.steady_interval > 0.0 and t >= next_check and t < t_end:
+        current = steady_invariants(problem, y)
+        # change per steady_interval, whatever the steps' length since the last check
+        elapsed = t - (next_check - options.steady_interval)
+        change = max_abs_difference(current, previous) * options.steady_interval / elapsed
+        quiet = quiet + 1 if change <= options.steady_tol else 0
+        if quiet >= STEADY_WINDOWS:
+            return STEADY, i_out, worst, next_check, current, quiet
+        previous = current
+        next_check = t + options.steady_interval
+    return -1, i_out, worst, next_check, previous, quiet
+
+
+@numba.njit(**JIT)
+def stop_check(options, n_steps, h, t, y):
+    """Status that ends the run before the next attempt, or -1."""
+    if n_steps >= options.max_steps:
+        return STEP_BUDGET
+    if h < max(options.min_step, 10.0 * np.finfo(np.float64).eps * abs(t)):
+        return STEP_UNDERFLOW if all_finite(y) else NON_FINITE
+    return -1

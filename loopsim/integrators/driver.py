@@ -1,0 +1,101 @@
+"""One adaptive driver for every method: the loop around a method's step attempts.
+
+The driver owns what no method should repeat: the first right-hand side
+and step size, output at requested times (steps are shortened to land on
+them exactly), the step budget and underflow, the model's constraint and
+steady-state monitors, and the status.  It never raises: failures come back
+as a status code (``integrators.control``).  The method-specific pieces
+(``start``, ``attempt``, ``advance``, see ``integrators.base``) are resolved on
+the method's type when the driver is compiled.
+"""
+import numba
+import numpy as np
+
+from ..config import JIT
+from ..models import rhs
+from .base import advance, attempt, start, statistics
+from .control import (
+    NON_FINITE, OK, all_finite, initial_step, landing, monitor, record_start, stop_check,
+)
+
+
+#: The run statistics returned by :func:`integrate`, in order (solve_ivp's names where
+#: they exist).
+COUNTS = ("steps_accepted", "steps_rejected", "nfev", "njev", "nlu")
+
+
+@numba.njit(**JIT)
+def _counts(method, work, counts, n_acc, n_rej, n_rhs):
+    njev, nlu = statistics(method, work)
+    counts[0] = n_acc
+    counts[1] = n_rej
+    counts[2] = n_rhs
+    counts[3] = njev
+    counts[4] = nlu
+    return counts
+
+
+@numba.njit(**JIT)
+def integrate(method, problem, y0, t0, t_end, t_out, options, y_out):
+    """Integrate dy/dt = rhs(problem, y) from t0 to t_end with ``method`` and ``options``
+    (``control.step_options``).
+
+    t_out: sorted output times in [t0, t_end]; the state at t_out[i] is written
+    to y_out[i].  Rows of y_out for times not reached are left untouched.
+
+    Returns (status, t, y, counts, max_constraint_error): counts (int64) =
+    [accepted steps, rejected steps, RHS evaluations, Jacobian evaluations, LU
+    factorisations] (``COUNTS``); max_constraint_error the largest
+    |constraint_error| seen at accepted steps (for a loop: the worst transient
+    relative length error).
+    """
+    counts = np.zeros(len(COUNTS), dtype=np.int64)
+    ny = y0.shape[0]
+    y = y0.copy()
+    f = np.empty(ny)
+    y_new = np.empty(ny)
+    n_acc = 0
+    n_rej = 0
+    worst = 0.0
+    t = t0
+    rhs(problem, y, f)
+    n_rhs = 1
+    if not all_finite(f) or not all_finite(y):
+        counts[2] = n_rhs
+        return NON_FINITE, t, y, counts, worst
+    i_out, next_check, previous, quiet = record_start(problem, y, t0, t_out, y_out, options)
+    work, evals = start(method, problem, y, f, options)
+    n_rhs += evals
+    if options.first_step > 0.0:
+        h = min(options.first_step, options.max_step)
+    else:
+        h = initial_step(problem, y, f, y_new, options.rtol, options.atol, method.error_order,
+                         options.max_step)
+        n_rhs += 1
+    while t < t_end:
+        stop = stop_check(options, n_acc + n_rej, h, t, y)
+        if stop >= 0:
+            return stop, t, y, _counts(method, work, counts, n_acc, n_rej, n_rhs), worst
+        h_try, clipped, t_stop = landing(t, h, t_end, t_out, i_out)
+        accepted, h_next, evals = attempt(method, work, problem, y, f, h_try, y_new, options)
+        n_rhs += evals
+        if not accepted:
+            n_rej += 1
+            h = h_next
+            continue
+        n_acc += 1
+        t = t_stop if clipped else t + h_try
+        y[:] = y_new
+        rhs(problem, y, f)
+        n_rhs += 1
+        if not all_finite(f):
+            return NON_FINITE, t, y, _counts(method, work, counts, n_acc, n_rej, n_rhs), worst
+        stop, i_out, worst, next_check, previous, quiet = monitor(
+            problem, t, y, t_end, t_out, y_out, options, i_out, worst, next_check, previous, quiet)
+        if stop >= 0:
+            return stop, t, y, _counts(method, work, counts, n_acc, n_rej, n_rhs), worst
+        h_next, evals = advance(method, work, problem, y, f, h_try, h_next)
+        n_rhs += evals
+        # a step shortened to hit an output time says nothing about the next h
+        h = min(options.max_step, max(h, h_next) if clipped else h_next)
+    return OK, t, y, _counts(method, work, counts, n_acc, n_rej, n_rhs), worst

@@ -1,0 +1,96 @@
+"""Explicit embedded Runge–Kutta methods: a method is its Butcher tableau.
+
+A :class:`Tableau` holds c, a (strictly lower triangular), the propagating
+weights b and the error weights e = b − b̂ (b̂ the embedded weights) and the
+order p of the error estimate; :func:`tableau_step` takes one step of any
+tableau.  Adding an explicit method is adding a ``Tableau`` constant and a
+name in ``integrators.METHODS``.
+"""
+import collections
+
+import numba
+import numpy as np
+
+from ..config import JIT
+from ..models import rhs
+from .base import advance, attempt, implements, start, statistics
+from .control import error_scale, rms_norm, step_factor
+
+#: c (s,), a (s, s), b (s,), e (s,) arrays; error_order: p of the O(h^(p+1)) estimate.
+Tableau = collections.namedtuple("Tableau", "c a b e error_order")
+
+# Runge–Kutta–Fehlberg 4(5): E. Fehlberg, NASA TR R-315 (1969), Table III.  We
+# advance with the 5th-order weights (local extrapolation) and use the
+# difference to the embedded 4th-order weights as the error estimate.
+RKF45_C = np.array([0.0, 1 / 4, 3 / 8, 12 / 13, 1.0, 1 / 2])
+RKF45_A = np.array(
+    [
+        [0.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        [1 / 4, 0.0, 0.0, 0.0, 0.0, 0.0],
+        [3 / 32, 9 / 32, 0.0, 0.0, 0.0, 0.0],
+        [1932 / 2197, -7200 / 2197, 7296 / 2197, 0.0, 0.0, 0.0],
+        [439 / 216, -8.0, 3680 / 513, -845 / 4104, 0.0, 0.0],
+        [-8 / 27, 2.0, -3544 / 2565, 1859 / 4104, -11 / 40, 0.0],
+    ]
+)
+RKF45_B5 = np.array([16 / 135, 0.0, 6656 / 12825, 28561 / 56430, -9 / 50, 2 / 55])
+RKF45_B4 = np.array([25 / 216, 0.0, 1408 / 2565, 2197 / 4104, -1 / 5, 0.0])
+RKF45 = Tableau(RKF45_C, RKF45_A, RKF45_B5, RKF45_B5 - RKF45_B4, 4)
+
+#: Per-run scratch: stage derivatives k (s, ny), stage state, error, error scale.
+ExplicitWork = collections.namedtuple("ExplicitWork", "k stage err scale")
+
+
+@numba.njit(**JIT)
+def tableau_step(tableau, problem, y, h, k, stage, y_new, err):
+    """One step of an explicit tableau from y with step h: y_new = y + h Σ b_j k_j and
+    err = h Σ e_j k_j, with k_s = F(y + h Σ_{j<s} a_sj k_j).
+
+    k[0] must hold F(y) on entry; k[1:] and ``stage`` are overwritten.
+    Returns the number of right-hand-side evaluations made (s − 1).
+    """
+    ny = y.shape[0]
+    stages = tableau.c.shape[0]
+    for s in range(1, stages):
+        for i in range(ny):
+            acc = 0.0
+            for j in range(s):
+                acc += tableau.a[s, j] * k[j, i]
+            stage[i] = y[i] + h * acc
+        rhs(problem, stage, k[s])
+    for i in range(ny):
+        acc_b = 0.0
+        acc_e = 0.0
+        for j in range(stages):
+            acc_b += tableau.b[j] * k[j, i]
+            acc_e += tableau.e[j] * k[j, i]
+        y_new[i] = y[i] + h * acc_b
+        err[i] = h * acc_e
+    return stages - 1
+
+
+@implements(start, Tableau)
+def _explicit_start(method, problem, y, f, options):
+    ny = y.shape[0]
+    work = ExplicitWork(np.empty((method.c.shape[0], ny)), np.empty(ny), np.empty(ny),
+                        np.empty(ny))
+    return work, 0
+
+
+@implements(attempt, Tableau)
+def _explicit_attempt(method, work, problem, y, f, h, y_new, options):
+    work.k[0] = f
+    evals = tableau_step(method, problem, y, h, work.k, work.stage, y_new, work.err)
+    error_scale(y, y_new, options.rtol, options.atol, work.scale)
+    err_norm = rms_norm(work.err, work.scale)
+    return err_norm <= 1.0, h * step_factor(err_norm, method.error_order), evals
+
+
+@implements(advance, Tableau)
+def _explicit_advance(method, work, problem, y, f, h, h_proposal):
+    return h_proposal, 0
+
+
+@implements(statistics, Tableau)
+def _explicit_statistics(method, work):
+    return 0, 0

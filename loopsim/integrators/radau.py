@@ -1,0 +1,329 @@
+"""Radau IIA (order 5) building blocks in Numba: tableau, LU, Jacobian, Newton.
+
+The 3-stage Radau IIA collocation method (Hairer & Wanner, *Solving ODEs II*,
+§IV.8) solves, for the stage increments Z_i = Y_i − y,
+
+    Z = h (A ⊗ I) F(y + Z),      y_new = y + Z_3,
+
+by simplified Newton iterations.  With A⁻¹ = T Λ T⁻¹, Λ = diag(μ_r, [[α, β],
+[−β, α]]), the Newton matrix decouples into one real system (μ_r/h − J) and
+one complex system (μ_c/h − J), μ_c = α − iβ, each LU-factorised once and
+reused while h and J stay.  The embedded error estimate is Hairer's
+(an order-3 companion using f(y)), filtered through the real LU.  The
+transformation T and the error weights are computed here from A, not typed
+in, and are tested as data.
+
+J comes from ``models.jacobian`` (exact for every model; for the loop it is
+``models.local_sbt.loop_jacobian``).  Step control, Jacobian and LU reuse
+follow scipy's Radau (Hairer's policies): the LU factors are kept while h
+does not change (h is held unless it should grow by ≥ HOLD_FACTOR or
+shrink), the Jacobian is refreshed after a slowly converging Newton iteration
+or when Newton fails with a stale one; a failed Newton cuts h by
+NEWTON_FAILURE_FACTOR.  :func:`fd_jacobian` is a forward-difference fallback
+for new models.  Everything writes into caller-owned arrays.
+"""
+import collections
+
+import numba
+import numpy as np
+
+from ..config import JIT
+from ..models import jacobian, rhs
+from .base import advance, attempt, implements, start, statistics
+from .control import MAX_FACTOR, MIN_FACTOR, SAFETY, rms_norm
+from .linalg import lu_factor, lu_solve
+
+_S6 = np.sqrt(6.0)
+C = np.array([(4.0 - _S6) / 10.0, (4.0 + _S6) / 10.0, 1.0])
+A = np.array([
+    [(88.0 - 7.0 * _S6) / 360.0, (296.0 - 169.0 * _S6) / 1800.0, (-2.0 + 3.0 * _S6) / 225.0],
+    [(296.0 + 169.0 * _S6) / 1800.0, (88.0 + 7.0 * _S6) / 360.0, (-2.0 - 3.0 * _S6) / 225.0],
+    [(16.0 - _S6) / 36.0, (16.0 + _S6) / 36.0, 1.0 / 9.0],
+])
+ERROR_ORDER = 3  # the embedded estimate is O(h^4): factor err^(-1/4)
+NEWTON_MAXITER = 6
+#: Refresh the Jacobian after an accepted step whose Newton iteration took more
+#: than JACOBIAN_ITERATIONS iterations at a contraction rate above JACOBIAN_RATE.
+JACOBIAN_ITERATIONS = 2
+JACOBIAN_RATE = 1e-3
+#: Keep h (and with it the LU factors) unless the controller asks for at least this growth.
+HOLD_FACTOR = 1.2
+#: Step-size factor after a Newton iteration that failed to converge.
+NEWTON_FAILURE_FACTOR = 0.5
+#: Newton tolerance max(NEWTON_TOL_FLOOR eps / rtol, min(NEWTON_TOL_MAX, sqrt(rtol))), as scipy.
+NEWTON_TOL_FLOOR = 10.0
+NEWTON_TOL_MAX = 0.03
+
+#: The method as data: its error order and the policy constants above.
+RadauIIA = collections.namedtuple(
+    "RadauIIA", "error_order newton_maxiter jacobian_iterations jacobian_rate hold_factor "
+    "newton_failure_factor")
+RADAU5 = RadauIIA(ERROR_ORDER, NEWTON_MAXITER, JACOBIAN_ITERATIONS, JACOBIAN_RATE, HOLD_FACTOR,
+                  NEWTON_FAILURE_FACTOR)
+
+
+def _transformation():
+    """T, T⁻¹, μ_r, μ_c with T⁻¹ A⁻¹ T = diag(μ_r, [[α, β], [−β, α]]), μ_c = α − iβ."""
+    values, vectors = np.linalg.eig(np.linalg.inv(A))
+    real = int(np.argmin(np.abs(values.imag)))
+    pair = int(np.argmax(values.imag))  # α + iβ with β > 0
+    v = vectors[:, pair]
+    t = np.column_stack([vectors[:, real].real, v.real, v.imag])
+    t = t / t[2, 0]  # any scaling works; this one makes row 3 of T start with 1
+    return t, np.linalg.inv(t), float(values[real].real), complex(values[pair].conjugate())
+
+
+def _embedded_weights(mu_real):
+    """E with err = (μ_r/h − J)⁻¹ (f(y) + Σ E_i Z_i / h) (Hairer's order-3 companion).
+
+    The companion uses b̂_0 = γ0 = 1/μ_r on f(y) and b̂_1..3 from the order
+    conditions Σ b̂_i c_i^(k−1) = 1/k, k = 1..3; E = μ_r (b̂ − b) A⁻¹, b = A[2].
+    """
+    gamma0 = 1.0 / mu_real
+    powers = np.vstack([C**k for k in range(3)])
+    rhs_k = np.array([1.0, 1.0 / 2.0, 1.0 / 3.0]) - np.array([gamma0, 0.0, 0.0])
+    b_hat = np.linalg.solve(powers, rhs_k)
+    return mu_real * (b_hat - A[2]) @ np.linalg.inv(A)
+
+
+T, TI, MU_REAL, MU_COMPLEX = _transformation()
+E = _embedded_weights(MU_REAL)
+#: Z_i = Σ_k q_k c_i^(k+1): the collocation polynomial's coefficients are q = V⁻¹ Z.
+VINV = np.linalg.inv(np.vander(C, 4, increasing=True)[:, 1:])
+
+
+@numba.njit(**JIT)
+def collocation_polynomial(z, q):
+    """q (3, n) with y(t_old + x h) = y_old + Σ_k q_k x^(k+1), from the stage increments z."""
+    for k in range(3):
+        for i in range(z.shape[1]):
+            q[k, i] = VINV[k, 0] * z[0, i] + VINV[k, 1] * z[1, i] + VINV[k, 2] * z[2, i]
+
+
+@numba.njit(**JIT)
+def extrapolated_guess(q, ratio, z):
+    """Newton start for the next step (h_new = ratio · h_old): the last step's collocation
+    polynomial evaluated at the new stage times, minus its end value."""
+    for r in range(3):
+        x = 1.0 + ratio * C[r]
+        for i in range(z.shape[1]):
+            z[r, i] = (q[0, i] * (x - 1.0) + q[1, i] * (x * x - 1.0)
+                       + q[2, i] * (x * x * x - 1.0))
+
+
+# ---- Newton matrices, iteration and error estimate -----------------------
+@numba.njit(**JIT)
+def fd_jacobian(problem, y, f, jac, y_work, f_work):
+    """jac[:, j] = (F(y + δ_j e_j) − F(y)) / δ_j, δ_j = √eps · max(1, |y_j|)."""
+    root_eps = np.sqrt(np.finfo(np.float64).eps)
+    y_work[:] = y
+    for j in range(y.shape[0]):
+        delta = root_eps * max(1.0, abs(y[j]))
+        y_work[j] = y[j] + delta
+        delta = y_work[j] - y[j]  # the step actually representable
+        rhs(problem, y_work, f_work)
+        for i in range(y.shape[0]):
+            jac[i, j] = (f_work[i] - f[i]) / delta
+        y_work[j] = y[j]
+
+
+@numba.njit(**JIT)
+def newton_matrices(jac, h, lu_real, piv_real, lu_complex, piv_complex):
+    """Factorise μ_r/h − J and μ_c/h − J."""
+    n = jac.shape[0]
+    for i in range(n):
+        for j in range(n):
+            lu_real[i, j] = -jac[i, j]
+            lu_complex[i, j] = -jac[i, j]
+        lu_real[i, i] += MU_REAL / h
+        lu_complex[i, i] += MU_COMPLEX / h
+    lu_factor(lu_real, piv_real)
+    lu_factor(lu_complex, piv_complex)
+
+
+@numba.njit(**JIT)
+def solve_collocation(problem, y, h, z, scale, tol, maxiter, lu_real, piv_real, lu_complex,
+                      piv_complex, w, fz, stage, real_rhs, complex_rhs):
+    """Simplified Newton for Z = h A F(y + Z), from the guess in z (3, n), updated in place.
+
+    Returns (converged, iterations, rate); 3 RHS evaluations per iteration.
+    """
+    n = y.shape[0]
+    m_real = MU_REAL / h
+    m_complex = MU_COMPLEX / h
+    for r in range(3):
+        for i in range(n):
+            w[r, i] = TI[r, 0] * z[0, i] + TI[r, 1] * z[1, i] + TI[r, 2] * z[2, i]
+    norm_old = -1.0
+    rate = -1.0
+    for iteration in range(maxiter):
+        for r in range(3):
+            for i in range(n):
+                stage[i] = y[i] + z[r, i]
+            rhs(problem, stage, fz[r])
+        for r in range(3):
+            for i in range(n):
+                if not np.isfinite(fz[r, i]):
+                    return False, iteration + 1, rate
+        for i in range(n):
+            tf0 = TI[0, 0] * fz[0, i] + TI[0, 1] * fz[1, i] + TI[0, 2] * fz[2, i]
+            tf1 = TI[1, 0] * fz[0, i] + TI[1, 1] * fz[1, i] + TI[1, 2] * fz[2, i]
+            tf2 = TI[2, 0] * fz[0, i] + TI[2, 1] * fz[1, i] + TI[2, 2] * fz[2, i]
+            real_rhs[i] = tf0 - m_real * w[0, i]
+            complex_rhs[i] = (tf1 + 1j * tf2) - m_complex * (w[1, i] + 1j * w[2, i])
+        lu_solve(lu_real, piv_real, real_rhs)
+        lu_solve(lu_complex, piv_complex, complex_rhs)
+        acc = 0.0
+        for i in range(n):
+            acc += (real_rhs[i] / scale[i]) ** 2 + (complex_rhs[i].real / scale[i]) ** 2 \
+                + (complex_rhs[i].imag / scale[i]) ** 2
+        norm = np.sqrt(acc / (3 * n))
+        if norm_old >= 0.0:
+            rate = norm / norm_old
+        if rate >= 0.0 and (rate >= 1.0 or
+                            rate ** (maxiter - iteration) / (1.0 - rate) * norm > tol):
+            return False, iteration + 1, rate
+        for i in range(n):
+            w[0, i] += real_rhs[i]
+            w[1, i] += complex_rhs[i].real
+            w[2, i] += complex_rhs[i].imag
+        for r in range(3):
+            for i in range(n):
+                z[r, i] = T[r, 0] * w[0, i] + T[r, 1] * w[1, i] + T[r, 2] * w[2, i]
+        if norm == 0.0 or (rate >= 0.0 and rate / (1.0 - rate) * norm < tol):
+            return True, iteration + 1, rate
+        norm_old = norm
+    return False, maxiter, rate
+
+
+@numba.njit(**JIT)
+def error_estimate(f0, z, h, lu_real, piv_real, out):
+    """out = (μ_r/h − J)⁻¹ (f(y) + Σ E_i Z_i / h)."""
+    for i in range(f0.shape[0]):
+        out[i] = f0[i] + (E[0] * z[0, i] + E[1] * z[1, i] + E[2] * z[2, i]) / h
+    lu_solve(lu_real, piv_real, out)
+
+
+# ---- step control (Hairer's policies, as scipy's Radau) -----------------------
+@numba.njit(**JIT)
+def predictive_factor(h, h_old, err_norm, err_old):
+    """Gustafsson's predictive step factor, before the safety factor:
+    min(1, (h / h_old)(err_old / err)^(1/4)) err^(-1/4)."""
+    multiplier = 1.0
+    if err_old > 0.0 and h_old > 0.0 and err_norm > 0.0:
+        multiplier = h / h_old * (err_old / err_norm) ** 0.25
+    if err_norm == 0.0:
+        return MAX_FACTOR
+    return min(1.0, multiplier) * err_norm ** -0.25
+
+
+#: Per-run arrays, and the scalars the policies carry from step to step
+#: (indices below, stored as float64).
+RadauWork = collections.namedtuple(
+    "RadauWork", "scale work_y work_f err real_rhs complex_rhs z poly w fz jac lu_real "
+    "lu_complex piv_real piv_complex scalars")
+(H_LU, H_OLD, ERR_OLD, REJECTED, JAC_CURRENT, NEWTON_TOL, ERR_NORM, RECOMPUTE_JAC, JACOBIANS,
+ FACTORISATIONS) = range(10)
+
+
+@implements(start, RadauIIA)
+def _radau_start(method, problem, y, f, options):
+    n = y.shape[0]
+    work = RadauWork(
+        np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n),
+        np.empty(n, dtype=np.complex128), np.zeros((3, n)), np.zeros((3, n)),
+        np.empty((3, n)), np.empty((3, n)), np.empty((n, n)), np.empty((n, n)),
+        np.empty((n, n), dtype=np.complex128), np.empty(n, dtype=np.int64),
+        np.empty(n, dtype=np.int64), np.zeros(10))
+    evals = jacobian(problem, y, f, work.jac, work.work_y, work.work_f)
+    s = work.scalars
+    s[JACOBIANS] = 1.0
+    s[H_LU] = -1.0
+    s[H_OLD] = -1.0  # last accepted step (-1: none yet)
+    s[ERR_OLD] = -1.0
+    s[REJECTED] = 0.0
+    s[JAC_CURRENT] = 1.0
+    s[NEWTON_TOL] = max(NEWTON_TOL_FLOOR * np.finfo(np.float64).eps / options.rtol,
+                        min(NEWTON_TOL_MAX, options.rtol ** 0.5))
+    return work, evals
+
+
+@implements(attempt, RadauIIA)
+def _radau_attempt(method, work, problem, y, f, h, y_new, options):
+    n = y.shape[0]
+    s = work.scalars
+    for i in range(n):
+        work.scale[i] = options.atol + options.rtol * abs(y[i])
+    evals = 0
+    while True:
+        if h != s[H_LU]:
+            newton_matrices(work.jac, h, work.lu_real, work.piv_real, work.lu_complex,
+                            work.piv_complex)
+            s[H_LU] = h
+            s[FACTORISATIONS] += 1.0
+        if s[H_OLD] > 0.0:
+            extrapolated_guess(work.poly, h / s[H_OLD], work.z)
+        else:
+            work.z[:] = 0.0
+        converged, iterations, rate = solve_collocation(
+            problem, y, h, work.z, work.scale, s[NEWTON_TOL], method.newton_maxiter,
+            work.lu_real, work.piv_real, work.lu_complex, work.piv_complex, work.w, work.fz,
+            work.work_y, work.real_rhs, work.complex_rhs)
+        evals += 3 * iterations
+        if converged or s[JAC_CURRENT] != 0.0:
+            break
+        evals += jacobian(problem, y, f, work.jac, work.work_y, work.work_f)
+        s[JACOBIANS] += 1.0
+        s[JAC_CURRENT] = 1.0
+        s[H_LU] = -1.0
+    if not converged:
+        s[REJECTED] = 1.0
+        return False, method.newton_failure_factor * h, evals
+    for i in range(n):
+        y_new[i] = y[i] + work.z[2, i]
+        work.scale[i] = options.atol + options.rtol * max(abs(y[i]), abs(y_new[i]))
+    error_estimate(f, work.z, h, work.lu_real, work.piv_real, work.err)
+    err_norm = rms_norm(work.err, work.scale)
+    if s[REJECTED] != 0.0 and err_norm > 1.0:  # Hairer's second filtering after a rejection
+        for i in range(n):
+            work.work_y[i] = y[i] + work.err[i]
+        rhs(problem, work.work_y, work.work_f)
+        evals += 1
+        error_estimate(work.work_f, work.z, h, work.lu_real, work.piv_real, work.err)
+        err_norm = rms_norm(work.err, work.scale)
+    maxiter = method.newton_maxiter
+    safety = SAFETY * (2 * maxiter + 1) / (2 * maxiter + iterations)
+    controller = predictive_factor(h, s[H_OLD], err_norm, s[ERR_OLD])
+    if not (err_norm <= 1.0):
+        s[REJECTED] = 1.0
+        return False, h * max(MIN_FACTOR, safety * controller), evals
+    s[REJECTED] = 0.0
+    recompute_jac = iterations > method.jacobian_iterations and rate > method.jacobian_rate
+    factor = min(MAX_FACTOR, safety * controller)
+    if not recompute_jac and factor < method.hold_factor:
+        factor = 1.0  # keep h, and with it the LU factors
+    s[ERR_NORM] = err_norm
+    s[RECOMPUTE_JAC] = 1.0 if recompute_jac else 0.0
+    return True, h * factor, evals
+
+
+@implements(advance, RadauIIA)
+def _radau_advance(method, work, problem, y, f, h, h_proposal):
+    s = work.scalars
+    evals = 0
+    if s[RECOMPUTE_JAC] != 0.0:
+        evals += jacobian(problem, y, f, work.jac, work.work_y, work.work_f)
+        s[JACOBIANS] += 1.0
+        s[JAC_CURRENT] = 1.0
+        s[H_LU] = -1.0
+    else:
+        s[JAC_CURRENT] = 0.0
+    collocation_polynomial(work.z, work.poly)
+    s[H_OLD] = h
+    s[ERR_OLD] = s[ERR_NORM]
+    return h_proposal, evals
+
+
+@implements(statistics, RadauIIA)
+def _radau_statistics(method, work):
+    return int(work.scalars[JACOBIANS]), int(work.scalars[FACTORISATIONS])

@@ -1,0 +1,25 @@
+"""Models: the equations of motion behind one interface (``models.base``).
+
+* ``local_sbt``: the sedimenting loop in local slender-body theory (the paper's model);
+* ``riccati``: a closed-form test problem for the integrators.
+
+A new model (say, nonlocal hydrodynamics) is one module implementing the
+interface, imported here so its implementations are registered.
+"""
+import numba
+
+from ..config import JIT
+from . import local_sbt, riccati  # noqa: F401 - importing registers the implementations
+from .base import (
+    auxiliary, constraint_error, for_case, implements, jacobian, rhs, steady_invariants,
+)
+
+__all__ = ["rhs", "jacobian", "constraint_error", "steady_invariants", "auxiliary",
+           "for_case", "implements", "evaluate", "local_sbt", "riccati"]
+
+
+@numba.njit(**JIT)
+def evaluate(problem, y, dydt, aux):
+    """dydt = F(y) and the model's auxiliary field at y (the tension multiplier of a loop)."""
+    rhs(problem, y, dydt)
+    auxiliary(problem, aux)

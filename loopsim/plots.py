@@ -1,0 +1,86 @@
+"""Publication-style figures from result tables (reads data, never integrates dynamics).
+
+Each function draws into ``ax`` (a new figure when None) and returns the
+figure; none changes the matplotlib backend (the CLI chooses Agg).
+"""
+import matplotlib.pyplot as plt
+import numpy as np
+
+from .stability import circle, paper
+
+REGIME_STYLE = {
+    "stable": dict(color="#3b0f70", marker="o", label="stable"),
+    "in-plane": dict(color="#21918c", marker="s", label="in-plane"),
+    "3d": dict(color="#f0c419", marker="^", label="3D"),
+    "failed": dict(color="#d62728", marker="x", label="failed"),
+}
+
+
+def _axes(ax, figsize):
+    if ax is None:
+        fig, ax = plt.subplots(figsize=figsize, constrained_layout=True)
+        return fig, ax
+    return ax.figure, ax
+
+
+def phase_diagram(frame, ax=None):
+    """g0 against θ0 coloured by regime, with the curves g0 = 3 q_c / sin θ0 of the
+    paper's linear stability (q_c = 14.561, wrong sign) and of the full linearisation of
+    the circle at the sweep's truncation (in-plane q_c ≈ 8.90, out-of-plane ≈ 10.65)."""
+    fig, ax = _axes(ax, (6.6, 4.0))
+    q_paper = paper.critical_q(20)
+    order = int(frame["n"].max())
+    for regime, style in REGIME_STYLE.items():
+        rows = frame[frame["regime"] == regime]
+        if len(rows):
+            ax.scatter(rows["theta0_deg"], rows["g0"], s=22, linewidths=1.2, **style)
+    theta = np.linspace(1.0, 90.0, 300)
+    ax.plot(theta, 3 * q_paper / np.sin(np.radians(theta)), "k-", lw=1.2,
+            label=f"paper's linear\nstability, q = {q_paper:.3f}")
+    for sector, style in (("in-plane", "--"), ("out-of-plane", ":")):
+        q_sector = circle.critical_q(max(order, 3), sector)
+        ax.plot(theta, 3 * q_sector / np.sin(np.radians(theta)), "k", ls=style, lw=1.2,
+                label=f"full linearisation,\n{sector}, q = {q_sector:.3f}")
+    ax.set_xlim(0, 92)
+    ax.set_ylim(0, 1.05 * frame["g0"].max())
+    ax.set_xlabel(r"initial tilt $\theta_0$ (deg)")
+    ax.set_ylabel(r"$g_0$ (gravity / stiffness)")
+    orders = sorted(frame["n"].unique())
+    ax.set_title(f"sedimentation regimes, n = {', '.join(map(str, orders))}, "
+                 f"t = {frame['t_end'].max():g}", fontsize=10)
+    ax.legend(fontsize=8, frameon=False, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    return fig
+
+
+def growth_rates(n=16, q_values=None, theta0_deg=90.0, w=None, ax=None):
+    """Largest growth rates vs q: the paper's operator, the corrected operator and both
+    sectors of the full Jacobian, with the critical q of each marked."""
+    kwargs = {} if w is None else dict(w=w)
+    fig, ax = _axes(ax, (6.4, 4.2))
+    q_values = np.linspace(0.0, 20.0, 81) if q_values is None else np.asarray(q_values, float)
+    rows = circle.paper_comparison(q_values, n, theta0_deg, **kwargs)
+    get = lambda key: [r[key] for r in rows]  # noqa: E731
+    ax.plot(q_values, get("paper"), "k--", label="paper's operator (§4)")
+    ax.plot(q_values, get("out_of_plane"), "C0-", lw=2, label="full J, out-of-plane")
+    ax.plot(q_values, get("corrected"), "C1:", lw=1.5, label="corrected operator")
+    ax.plot(q_values, get("in_plane"), "C3-", lw=2, label="full J, in-plane")
+    ax.axhline(0.0, color="0.6", lw=0.8)
+    for sector, color in (("in-plane", "C3"), ("out-of-plane", "C0")):
+        qc = circle.critical_q(n, sector, theta0_deg, **kwargs)
+        ax.axvline(qc, color=color, lw=0.8, ls="--")
+        ax.annotate(f"{qc:.4f}", (qc, -14), color=color, rotation=90, ha="right", va="bottom")
+    qp = paper.critical_q(n)
+    ax.annotate(f"{qp:.4f}", (qp, -14), color="k", rotation=90, ha="right", va="bottom")
+    ax.set_ylim(-15, 15)
+    ax.set_xlabel("q = g0 sin θ0 / 3")
+    ax.set_ylabel("largest growth rate σ")
+    ax.set_title(f"translating circle, n = {n}")
+    ax.legend(frameon=False)
+    return fig
+
+
+def save(fig, path, dpi=200):
+    """Write ``fig`` to ``path`` and close it."""
+    fig.savefig(path, dpi=dpi)
+    plt.close(fig)
+    return path
