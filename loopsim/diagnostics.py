@@ -7,6 +7,7 @@ run summary, the sweep table's columns and the trajectory table; adding one
 there adds it to all three.
 """
 import collections
+import functools
 import math
 
 import numpy as np
@@ -126,21 +127,35 @@ def stability_parameter(g0, theta_deg):
 
 
 # ---- the registry -----------------------------------------------------------------
-#: A state: coefficients x (3, 2n+1), velocity u (3, 2n+1), tension multiplier (2n+1,), g0.
-State = collections.namedtuple("State", "x u multiplier g0")
+class State:
+    """A state: coefficients x (3, 2n+1), velocity u (3, 2n+1), tension multiplier
+    (2n+1,), g0; with the quantities several diagnostics share, computed once."""
+
+    def __init__(self, x, u, multiplier, g0):
+        self.x, self.u, self.multiplier, self.g0 = x, u, multiplier, g0
+
+    @functools.cached_property
+    def tilt_deg(self):
+        return tilt_deg(self.x)
+
+    @functools.cached_property
+    def tension_extremes(self):
+        return tension_extremes(self.x, self.multiplier)
+
+
 #: name: summary and sweep-table column; function(State) -> value; dtype: its Arrow/NumPy
 #: type name; trajectory: its column in the trajectory table (None: summary only).
 Diagnostic = collections.namedtuple("Diagnostic", "name function dtype trajectory doc")
 
 
 def _tension(index):
-    return lambda state: tension_extremes(state.x, state.multiplier)[index]
+    return lambda state: state.tension_extremes[index]
 
 
 REGISTRY = [
-    Diagnostic("theta_final_deg", lambda s: tilt_deg(s.x), "float64", "theta_deg",
+    Diagnostic("theta_final_deg", lambda s: s.tilt_deg, "float64", "theta_deg",
                "tilt of the best-fit plane to the horizontal (deg)"),
-    Diagnostic("q_final", lambda s: stability_parameter(s.g0, tilt_deg(s.x)), "float64", None,
+    Diagnostic("q_final", lambda s: stability_parameter(s.g0, s.tilt_deg), "float64", None,
                "g0 sin(theta) / 3 at the final tilt"),
     Diagnostic("aspect_ratio", lambda s: aspect_ratio(s.x), "float64", "aspect_ratio",
                "largest / middle covariance eigenvalue"),

@@ -40,7 +40,3 @@ def implements(stub, cls):
 
     return register
 
-
-def implementations(stub):
-    """{class: implementation} registered for the generic ``stub``."""
-    return dict(_IMPLEMENTATIONS[stub])

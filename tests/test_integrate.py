@@ -10,10 +10,6 @@ from loopsim.models import riccati
 METHODS = sorted(I.METHODS.items())
 
 
-def riccati_exact(rates, y0, t):
-    return y0 / (1.0 - rates * y0 * t)
-
-
 RATES = np.array([1.0, -0.5, 0.3, 2.0])
 Y0 = np.array([0.5, 1.0, -1.0, 0.1])
 
@@ -43,7 +39,7 @@ def test_adaptive_run_meets_tolerance_at_output_times(name, method):
     (status, t, y, counts, _), y_out = run(method, 0.9, t_out)
     n_acc, n_rhs = counts[0], counts[2]
     assert status == I.OK and t == 0.9
-    exact = riccati_exact(RATES[None], Y0[None], t_out[:, None])
+    exact = riccati.exact_solution(RATES[None], Y0[None], t_out[:, None])
     np.testing.assert_allclose(y_out, exact, rtol=1e-6, atol=1e-8)
     np.testing.assert_array_equal(y_out[-1], y)
     assert n_rhs >= 6 * n_acc
@@ -62,7 +58,7 @@ def test_fixed_step_order(name, method):
         (status, t, y, counts, _), _ = run(method, 0.8, [], rtol=1e10, atol=1e10, h_init=h, h_max=h,
                                            y0=y0)
         assert status == I.OK and counts[0] == round(0.8 / h)
-        errors.append(np.abs(y - riccati_exact(RATES, y0, 0.8)).max())
+        errors.append(np.abs(y - riccati.exact_solution(RATES, y0, 0.8)).max())
     slopes = np.diff(np.log(errors)) / np.diff(np.log(steps))
     assert np.all(slopes > 4.7), slopes
 
@@ -72,7 +68,7 @@ def test_error_falls_with_tolerance(name, method):
     errors = []
     for rtol in (1e-4, 1e-6, 1e-8, 1e-10):
         (status, t, y, *_), _ = run(method, 0.9, [], rtol=rtol, atol=rtol * 1e-2)
-        errors.append(np.abs(y - riccati_exact(RATES, Y0, 0.9)).max())
+        errors.append(np.abs(y - riccati.exact_solution(RATES, Y0, 0.9)).max())
     assert errors[-1] < 1e-8 and all(b < a for a, b in zip(errors, errors[1:]))
 
 
@@ -144,6 +140,6 @@ def test_radau_fixed_step_order():
                     break
             assert converged
             y = y + z[2]
-        errors.append(np.abs(y - riccati_exact(RATES, y0, 0.8)).max())
+        errors.append(np.abs(y - riccati.exact_solution(RATES, y0, 0.8)).max())
     slopes = np.diff(np.log(errors)) / np.diff(np.log(steps))
     assert np.all(slopes > 4.5), (errors, slopes)

@@ -22,6 +22,7 @@ factor 2π / M), and the projections of f (order 2n) and of (x'·f) x'
 (order 3n) onto order n are alias-free there.
 """
 import collections
+import functools
 
 import numba
 import numpy as np
@@ -54,8 +55,10 @@ def grid_size(n):
     return 4 * n + 1
 
 
+@functools.lru_cache(maxsize=64)
 def make_operators(n):
-    """Build the constant matrices for truncation order n."""
+    """The constant matrices for truncation order n (built once per n and shared: never
+    written to)."""
     m = grid_size(n)
     S = [spectral.synthesis_matrix(n, m, d) for d in (0, 1, 2, 4)]
     F = spectral.analysis_matrix(n, m)
@@ -373,11 +376,6 @@ def make_problem(n, g0, w, ops=None):
     """Loop problem at truncation n (operators shared when given)."""
     ops = make_operators(n) if ops is None else ops
     return LoopProblem(float(g0), float(w), ops, make_workspace(n))
-
-
-def state_size(n):
-    """Length of the flat state vector: 3 (2n + 1)."""
-    return 3 * spectral.n_coeffs(n)
 
 
 @implements(rhs, LoopProblem)

@@ -6,18 +6,12 @@ statuses of every registered integrator.
 """
 import collections
 
-import numpy as np
-
 from .base import (
     auxiliary, constraint_error, for_case, implements, jacobian, rhs, steady_invariants,
 )
 
 RiccatiProblem = collections.namedtuple("RiccatiProblem", "rates")
 PARAMETERS = ()
-
-
-def make_problem(rates):
-    return RiccatiProblem(np.ascontiguousarray(rates, dtype=float))
 
 
 def exact_solution(rates, y0, t):

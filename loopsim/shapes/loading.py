@@ -292,7 +292,7 @@ def start_shape(theta0_deg=None, n=None, perturbation=None, seed=0, initial=None
         n = DEFAULT_N if n is None else n
         x0 = initial_shape(n, math.radians(theta0_deg), perturbation, seed)
         return x0, theta0_deg, n, perturbation, None
-    if theta0_deg is not None and not (isinstance(theta0_deg, float) and math.isnan(theta0_deg)):
+    if theta0_deg is not None:
         raise ValueError(f"theta0_deg must be None with an initial shape (its tilt is "
                          f"measured), got {theta0_deg!r}")
     start, info = resolve_initial(initial, n, initial_case_id)

@@ -80,11 +80,6 @@ SECTORS = ("in-plane", "out-of-plane")
 
 
 # ---------------------------------------------------------------- helpers
-@functools.lru_cache(maxsize=32)
-def _operators(n):
-    return local_sbt.make_operators(n)
-
-
 def _check_n(n, low=3):
     return validation.check_integer("n", n, low)
 
@@ -118,7 +113,7 @@ def rhs_jacobian(x, g0, w=DEFAULT_W):
     x.ravel() (component-major): ``models.local_sbt.loop_jacobian``."""
     x = np.ascontiguousarray(x, dtype=float)
     n = (x.shape[1] - 1) // 2
-    problem = local_sbt.make_problem(n, g0, w, _operators(n))
+    problem = local_sbt.make_problem(n, g0, w, local_sbt.make_operators(n))
     jac = np.empty((x.size, x.size))
     local_sbt.loop_jacobian(x, problem.g0, problem.w, problem.ops, problem.ws, jac)
     return jac
@@ -165,7 +160,7 @@ def _bases(n):
     space of E, Qo the Z coordinates without Z0, Z_a1, Z_b1.
     """
     K = 2 * n + 1
-    ops = _operators(n)
+    ops = local_sbt.make_operators(n)
     s = 2.0 * np.pi * np.arange(ops.m) / ops.m
     E = np.hstack([np.cos(s)[:, None] * ops.S1, -np.sin(s)[:, None] * ops.S1])
     _, sv, vt = np.linalg.svd(E)
