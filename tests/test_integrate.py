@@ -5,6 +5,7 @@ import pytest
 from loopsim import integrators as I
 from loopsim.integrators import explicit
 from loopsim.integrators import radau as R
+from loopsim.integrators.linalg import PIVOT_DTYPE
 from loopsim.models import riccati
 
 METHODS = sorted(I.METHODS.items())
@@ -124,7 +125,7 @@ def test_radau_fixed_step_order():
         f, work_y, work_f = np.empty(n), np.empty(n), np.empty(n)
         jac = np.empty((n, n))
         lu_r, lu_c = np.empty((n, n)), np.empty((n, n), complex)
-        piv_r, piv_c = np.empty(n, np.int64), np.empty(n, np.int64)
+        piv_r, piv_c = np.empty(n, PIVOT_DTYPE), np.empty(n, PIVOT_DTYPE)
         z, w, fz = np.zeros((3, n)), np.empty((3, n)), np.empty((3, n))
         real_rhs, complex_rhs = np.empty(n), np.empty(n, complex)
         for _ in range(round(0.8 / h)):

@@ -9,24 +9,24 @@ import numpy as np
 import pytest
 
 import naive
-from loopsim.integrators.linalg import lu_factor, lu_solve
+from loopsim.integrators.linalg import PIVOT_DTYPE, factor, lu_solve
 from loopsim.models import local_sbt
 
 
 def _factor_and_solve(a, b):
     """lu_factor on a copy of a, then lu_solve on a copy of b: (x, lu, piv)."""
     lu = np.array(a, copy=True)
-    piv = np.empty(a.shape[0], dtype=np.int64)
-    lu_factor(lu, piv)
+    piv = np.empty(a.shape[0], dtype=PIVOT_DTYPE)
+    assert factor(lu, piv) == 0
     x = np.array(b, copy=True)
     lu_solve(lu, piv, x)
     return x, lu, piv
 
 
 def _permutation(piv):
-    """Row order of P a for LAPACK-style swaps piv (row k swapped with piv[k] at step k)."""
+    """Row order of P m for LAPACK's 1-based swaps piv (row k swapped with piv[k] - 1)."""
     order = np.arange(piv.size)
-    for k, p in enumerate(piv):
+    for k, p in enumerate(piv - 1):
         order[[k, p]] = order[[p, k]]
     return order
 
@@ -69,7 +69,8 @@ def _lu_tolerance(a, x):
 @pytest.mark.parametrize("dtype", [np.float64, np.complex128])
 def test_lu_solve_matches_lapack_on_random_matrices(size, dtype, rng):
     """lu_factor / lu_solve against numpy.linalg.solve (LAPACK gesv) on Gaussian
-    matrices (cond ≤ 1e4 checked; 51 = 3K at n = 8), and P a = L U from the pivots.
+    matrices (cond ≤ 1e4 checked; 51 = 3K at n = 8), and P aᵀ = L U from the pivots
+    (LAPACK's factors of the column-major reading of a, see ``linalg``).
 
     Solutions: :func:`_lu_tolerance`.  Factors: backward error ≲ size · ε · growth
     · max|a|, measured ≤ 7.8e-17 size max|a|, tolerance 4e-16 size max|a|.
@@ -86,12 +87,16 @@ def test_lu_solve_matches_lapack_on_random_matrices(size, dtype, rng):
     assert x.dtype == dtype
     expected = naive.lu_solve(a, b)
     np.testing.assert_allclose(x, expected, rtol=0, atol=_lu_tolerance(a, expected))
-    # the factors themselves: unit lower L, upper U, P a = L U
-    lower = np.tril(lu, -1) + np.eye(size)
-    upper = np.triu(lu)
-    np.testing.assert_allclose(lower @ upper, a[_permutation(piv)], rtol=0,
+    # the factors themselves (column-major: the transpose of the row-major buffer):
+    # unit lower L, upper U, P aᵀ = L U
+    lower = np.tril(lu.T, -1) + np.eye(size)
+    upper = np.triu(lu.T)
+    np.testing.assert_allclose(lower @ upper, a.T[_permutation(piv)], rtol=0,
                                atol=4e-16 * size * np.abs(a).max())
-    assert np.abs(np.tril(lu, -1)).max(initial=0.0) <= 1.0  # partial pivoting: |l_ij| ≤ 1
+    # partial pivoting bounds the multipliers: |l| ≤ 1 for real; LAPACK picks complex
+    # pivots by |Re| + |Im| (izamax), which bounds |l| by √2
+    bound = 1.0 if dtype is np.float64 else np.sqrt(2.0)
+    assert np.abs(np.tril(lu.T, -1)).max(initial=0.0) <= bound
     # the factorisation is reusable: a second right-hand side with the same lu, piv
     b2 = draw(size)
     x2 = np.array(b2, copy=True)
@@ -113,7 +118,7 @@ def test_lu_solve_pivots_zero_and_tiny_leading_entries(dtype, rng):
     for a, expected in ((zero_lead, None), (tiny_lead, np.array([1.0, 1.0]))):
         b = np.arange(1, a.shape[0] + 1).astype(dtype)
         x, _, piv = _factor_and_solve(a, b)
-        assert piv[0] != 0  # the first step swapped rows
+        assert piv[0] != 1  # the first step swapped rows (1-based pivots)
         if expected is None:
             expected = naive.lu_solve(a, b)
         np.testing.assert_allclose(x, expected, rtol=0, atol=_lu_tolerance(a, expected))

@@ -31,7 +31,7 @@ from ..config import JIT
 from ..models import jacobian, rhs
 from .base import advance, attempt, implements, start, statistics
 from .control import MAX_FACTOR, MIN_FACTOR, SAFETY, rms_norm
-from .linalg import lu_factor, lu_solve
+from .linalg import PIVOT_DTYPE, lu_factor, lu_solve
 
 _S6 = np.sqrt(6.0)
 C = np.array([(4.0 - _S6) / 10.0, (4.0 + _S6) / 10.0, 1.0])
@@ -233,8 +233,8 @@ def _radau_start(method, problem, y, f, options):
         np.empty(n), np.empty(n), np.empty(n), np.empty(n), np.empty(n),
         np.empty(n, dtype=np.complex128), np.zeros((3, n)), np.zeros((3, n)),
         np.empty((3, n)), np.empty((3, n)), np.empty((n, n)), np.empty((n, n)),
-        np.empty((n, n), dtype=np.complex128), np.empty(n, dtype=np.int64),
-        np.empty(n, dtype=np.int64), np.zeros(10))
+        np.empty((n, n), dtype=np.complex128), np.empty(n, dtype=PIVOT_DTYPE),
+        np.empty(n, dtype=PIVOT_DTYPE), np.zeros(10))
     evals = jacobian(problem, y, f, work.jac, work.work_y, work.work_f)
     s = work.scalars
     s[JACOBIANS] = 1.0
