@@ -20,6 +20,7 @@ import numpy as np
 
 import loopsim
 from loopsim import shapes
+from loopsim.linalg import least_squares_affine
 from loopsim.models import local_sbt as physics
 
 
@@ -33,7 +34,7 @@ def _time_maps(x, g0, w, ops, ws, repeats):
 def _time_solve(block, ws, repeats):
     for _ in range(repeats):
         ws.length_rate[:] = block
-        physics.least_squares_affine(ws.length_rate, ws.tension)
+        least_squares_affine(ws.length_rate, ws.tension, ws.tau)
 
 
 @numba.njit(cache=True)

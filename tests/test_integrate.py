@@ -5,7 +5,7 @@ import pytest
 from loopsim import integrators as I
 from loopsim.integrators import explicit
 from loopsim.integrators import radau as R
-from loopsim.integrators.linalg import PIVOT_DTYPE
+from loopsim.linalg import PIVOT_DTYPE
 from loopsim.models import riccati
 
 METHODS = sorted(I.METHODS.items())

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import naive
-from loopsim.integrators.linalg import PIVOT_DTYPE, factor, lu_solve
+from loopsim.linalg import PIVOT_DTYPE, factor, lu_solve
 from loopsim.models import local_sbt
 
 

@@ -31,7 +31,7 @@ from ..config import JIT
 from ..models import jacobian, rhs
 from .base import advance, attempt, implements, start, statistics
 from .control import MAX_FACTOR, MIN_FACTOR, SAFETY, rms_norm
-from .linalg import PIVOT_DTYPE, lu_factor, lu_solve
+from ..linalg import PIVOT_DTYPE, lu_factor, lu_solve
 
 _S6 = np.sqrt(6.0)
 C = np.array([(4.0 - _S6) / 10.0, (4.0 + _S6) / 10.0, 1.0])

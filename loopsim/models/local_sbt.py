@@ -29,6 +29,7 @@ import numpy as np
 
 from .. import spectral
 from ..config import JIT
+from ..linalg import least_squares_affine
 from .base import (
     auxiliary, constraint_error, for_case, implements, jacobian, rhs, steady_invariants,
 )
@@ -45,8 +46,12 @@ LoopOperators = collections.namedtuple(
 #: Per-case scratch arrays, so the right-hand side never allocates.  Column
 #: blocks are stored (M, 3, J): grid point, component, column, so that each
 #: map is one matrix product (M, M) @ (M, 3J).
+#: ``length_rate`` (K+1, M) is the affine map T -> ε stored column by column (row j:
+#: the column of T = φ_j; row K: the affine part), as LAPACK's QR wants it; ``tau``
+#: is the QR's scratch.
 Workspace = collections.namedtuple(
-    "Workspace", "tangent curvature x4 raw force mobile dmobile length_rate velocity tension"
+    "Workspace",
+    "tangent curvature x4 raw force mobile dmobile length_rate velocity tension tau"
 )
 
 
@@ -76,7 +81,8 @@ def make_workspace(n):
     return Workspace(
         np.empty((3, m)), np.empty((3, m)), np.empty((3, m)),
         np.empty((m, 3, k + 1)), np.empty((m, 3, k + 1)), np.empty((m, 3, k + 1)),
-        np.empty((m, 3, k + 1)), np.empty((m, k + 1)), np.empty((3, m)), np.empty(k),
+        np.empty((m, 3, k + 1)), np.empty((k + 1, m)), np.empty((3, m)), np.empty(k),
+        np.empty(k),
     )
 
 
@@ -120,52 +126,16 @@ def velocity_map(ws):
 
 @numba.njit(**JIT)
 def length_creation_map(w, ops, ws):
-    """Map (3): ε = x'·(P_n u)' - w (1 - x'·x'), as a block of columns."""
+    """Map (3): ε = x'·(P_n u)' - w (1 - x'·x'), as a block of columns (stored as rows)."""
     m, cols = ops.m, ws.mobile.shape[2]
     np.dot(ops.P1, ws.mobile.reshape((m, 3 * cols)), ws.dmobile.reshape((m, 3 * cols)))
     t, du = ws.tangent, ws.dmobile
     k = cols - 1
     for i in range(m):
         for j in range(cols):
-            ws.length_rate[i, j] = t[0, i] * du[i, 0, j] + t[1, i] * du[i, 1, j] + t[2, i] * du[i, 2, j]
+            ws.length_rate[j, i] = t[0, i] * du[i, 0, j] + t[1, i] * du[i, 1, j] + t[2, i] * du[i, 2, j]
         stretch = t[0, i] ** 2 + t[1, i] ** 2 + t[2, i] ** 2
-        ws.length_rate[i, k] -= w * (1.0 - stretch)
-
-
-@numba.njit(**JIT)
-def least_squares_affine(a, out):
-    """Solve min_τ ||A τ + b||₂ for the augmented block a = [A | b] (destroyed).
-
-    Householder QR of A (columns 0..K-1) applied to b as well, then back
-    substitution R τ = -(Qᵀ b)[:K].  A must have full column rank.
-    """
-    m, cols = a.shape
-    k = cols - 1
-    for j in range(k):
-        norm = 0.0
-        for i in range(j, m):
-            norm += a[i, j] * a[i, j]
-        norm = np.sqrt(norm)
-        alpha = -norm if a[j, j] >= 0.0 else norm
-        # v = a[j:, j] - alpha e_1, stored in place; H = I - 2 v vᵀ / vᵀv
-        a[j, j] -= alpha
-        vtv = 0.0
-        for i in range(j, m):
-            vtv += a[i, j] * a[i, j]
-        if vtv > 0.0:
-            for jj in range(j + 1, cols):
-                dot = 0.0
-                for i in range(j, m):
-                    dot += a[i, j] * a[i, jj]
-                scale = 2.0 * dot / vtv
-                for i in range(j, m):
-                    a[i, jj] -= scale * a[i, j]
-        a[j, j] = alpha
-    for j in range(k - 1, -1, -1):
-        acc = -a[j, k]
-        for jj in range(j + 1, k):
-            acc -= a[j, jj] * out[jj]
-        out[j] = acc / a[j, j]
+        ws.length_rate[k, i] -= w * (1.0 - stretch)
 
 
 @numba.njit(**JIT)
@@ -184,7 +154,7 @@ def loop_velocity(x, g0, w, ops, ws, u_out):
     The least-squares solve destroys ws.length_rate; the residual is not kept.
     """
     compose_maps(x, g0, w, ops, ws)
-    least_squares_affine(ws.length_rate, ws.tension)
+    least_squares_affine(ws.length_rate, ws.tension, ws.tau)
     k = ops.S0.shape[1]
     for i in range(ops.m):
         for c in range(3):
@@ -200,9 +170,9 @@ def length_creation(x, tension, g0, w, ops, ws):
     """Grid values of ε for a given tension (the residual of the tension solve)."""
     compose_maps(x, g0, w, ops, ws)
     k = ops.S0.shape[1]
-    eps = ws.length_rate[:, k].copy()
+    eps = ws.length_rate[k].copy()
     for j in range(k):
-        eps += ws.length_rate[:, j] * tension[j]
+        eps += ws.length_rate[j] * tension[j]
     return eps
 
 

@@ -1,10 +1,11 @@
-"""Dense LU for the implicit methods: LAPACK's getrf from Numba, and the two triangular solves.
+"""Dense linear algebra in Numba: LAPACK's LU (implicit integrators) and QR (tension solve).
 
-The factorisation, the O(n³) part, is LAPACK's blocked getrf from scipy's
-LAPACK, reached through the ``numba_xxgetrf`` wrapper that Numba itself uses
-for ``np.linalg`` (an external symbol, so kernels calling it stay cacheable;
-real and complex by the array's dtype).  The O(n²) solve with those factors
-is written here, since Numba wraps no getrs.
+The factorisations, the O(n³) parts, are scipy's LAPACK getrf and geqrf,
+reached through the ``numba_xxgetrf`` and ``numba_ez_geqrf`` wrappers that
+Numba itself uses for ``np.linalg`` (external symbols, so kernels calling
+them stay cacheable; real and complex LU by the array's dtype).  The O(n²)
+work with those factors (triangular solves, applying the reflectors) is
+written here, since Numba wraps no getrs or ormqr.
 
 Convention.  Arrays are row-major (C order); LAPACK reads a row-major a as
 the column-major aᵀ and factorises it, P aᵀ = L U.  Hence a = Uᵀ Lᵀ P, and in
@@ -12,6 +13,8 @@ the row-major buffer ``lu`` left by :func:`lu_factor`, Uᵀ is the lower
 triangle with the diagonal and Lᵀ the strict upper triangle (unit diagonal);
 ``piv`` holds LAPACK's 1-based row swaps.  :func:`lu_solve` solves a x = b:
 Uᵀ z = b (forward), Lᵀ w = z (backward), x = Pᵀ w (the swaps in reverse).
+:func:`least_squares_affine` takes its block already column-major: row j of
+the row-major buffer is column j of the matrix.
 """
 import numba
 import numpy as np
@@ -19,7 +22,7 @@ from numba import types
 from numba.extending import overload
 from numba.np.linalg import F_INT_nbtype, F_INT_nptype, ensure_lapack
 
-from ..config import JIT
+from .config import JIT
 
 ensure_lapack()
 #: Integer type of the pivot array (LAPACK's Fortran integer).
@@ -35,6 +38,11 @@ def _getrf(dtype):
 
 
 _GETRF = {dtype: _getrf(dtype) for dtype in _KIND}
+#: numba_ez_geqrf(kind, m, n, a, lda, tau) -> info, real only.
+_GEQRF = types.ExternalFunction("numba_ez_geqrf", types.intc(
+    types.char, types.intp, types.intp, types.CPointer(types.float64), types.intp,
+    types.CPointer(types.float64)))
+_REAL = ord("d")
 
 
 def lu_factor(a, piv):
@@ -79,3 +87,31 @@ def lu_solve(lu, piv, b):
 def factor(a, piv):
     """:func:`lu_factor` callable from Python (tests, benchmarks)."""
     return lu_factor(a, piv)
+
+
+@numba.njit(**JIT)
+def least_squares_affine(block, out, tau):
+    """Solve min_τ ||A τ + b||₂ for the block stored column-major: rows 0..K-1 of
+    ``block`` (K+1, M) are the columns of A (M, K), row K is b; block is destroyed.
+
+    LAPACK's Householder QR of A in place (geqrf; tau (K,) scratch), the same
+    reflectors H_j = I − tau_j v_j v_jᵀ applied to b, then back substitution
+    R τ = −(Qᵀ b)[:K].  A must have full column rank.
+    """
+    k = block.shape[0] - 1
+    m = block.shape[1]
+    _GEQRF(_REAL, m, k, block.ctypes, m, tau.ctypes)
+    b = block[k]
+    for j in range(k):  # b <- H_j b, v_j = [1, block[j, j+1:]]
+        dot = b[j]
+        for i in range(j + 1, m):
+            dot += block[j, i] * b[i]
+        dot *= tau[j]
+        b[j] -= dot
+        for i in range(j + 1, m):
+            b[i] -= dot * block[j, i]
+    for i in range(k - 1, -1, -1):  # R[i, j] = block[j, i] for j >= i
+        acc = -b[i]
+        for j in range(i + 1, k):
+            acc -= block[j, i] * out[j]
+        out[i] = acc / block[i, i]
