@@ -10,7 +10,7 @@ import sys
 
 from ._version import __version__
 from .config import (
-    DEFAULT_ATOL, DEFAULT_N, DEFAULT_PERTURBATION, DEFAULT_RTOL, DEFAULT_SEED,
+    RESOLVED_LENGTH_ERROR, RESOLVED_TAIL, DEFAULT_ATOL, DEFAULT_N, DEFAULT_PERTURBATION, DEFAULT_RTOL, DEFAULT_SEED,
     DEFAULT_T_END, DEFAULT_W,
 )
 
@@ -206,7 +206,7 @@ def _format_initial(info):
 
 
 def _cmd_run(args):
-    from . import api, io
+    from . import api, ensemble, io
 
     g0, start, info = args.g0, None, None
     if args.initial is not None:
@@ -226,6 +226,11 @@ def _cmd_run(args):
         result.initial_info = info
         for warning in info["warnings"]:
             print(f"loopsim: warning: {warning}", file=sys.stderr)
+    if not ensemble.Thresholds().resolved(result.length_error_max, summary["spectral_tail"]):
+        print(f"loopsim: warning: not resolved at n = {summary['n']} (length error up to "
+              f"{result.length_error_max:.2g}, limit {RESOLVED_LENGTH_ERROR:g}; terminal spectral "
+              f"tail {summary['spectral_tail']:.2g}, limit {RESOLVED_TAIL:g}): the terminal tilt "
+              "and shape are not converged; increase --n", file=sys.stderr)
     if args.out and info is None:
         io.write_trajectory(result, args.out, command_line=sys.argv)
     elif args.out:  # the initial shape's diagnostics (scale, source) as metadata "initial"
@@ -270,6 +275,14 @@ def _cmd_sweep(args):
                                command_line=sys.argv)
     counts = frame["regime"].value_counts().to_dict()
     print(f"{len(frame)} cases in {args.out}: " + ", ".join(f"{k} {v}" for k, v in sorted(counts.items())))
+    unresolved = frame[~frame["resolved"]]
+    if len(unresolved):
+        print(f"{len(unresolved)} of {len(frame)} cases NOT resolved at their n (transient length "
+              f"error > {config.thresholds.resolved_length_error:g} or terminal spectral tail > "
+              f"{config.thresholds.resolved_tail:g}; column 'resolved'): their "
+              f"terminal tilt and shape are not converged; rerun them with a larger --n "
+              f"(regimes among them: " + ", ".join(
+                  f"{k} {v}" for k, v in sorted(unresolved["regime"].value_counts().items())) + ")")
     if args.figure:
         _use_agg()
         plots.save(plots.phase_diagram(frame), args.figure)

@@ -172,6 +172,9 @@ REGISTRY = [
     Diagnostic("s_tension_max", _tension(2), "float64", None, "arc length of the largest force"),
     Diagnostic("length_error", lambda s: relative_length_error(s.x), "float64", "length_error",
                "(L - 2 pi) / 2 pi"),
+    Diagnostic("spectral_tail", lambda s: spectral_tail(s.x, spectral.order_of(s.x.shape[-1])),
+               "float64", "spectral_tail",
+               "RMS share of the two top modes kept (k >= max(2, n-1)): large means n too small"),
 ]
 
 

@@ -25,7 +25,8 @@ import pyarrow as pa
 from . import api, batch, diagnostics, integrators, io, models, shapes, validation
 from .config import (
     DEFAULT_ATOL, DEFAULT_LENGTH_TOL, DEFAULT_MAX_STEPS, DEFAULT_PERTURBATION, DEFAULT_RTOL,
-    DEFAULT_STEADY_INTERVAL, DEFAULT_STEADY_TOL, DEFAULT_T_END, DEFAULT_W,
+    DEFAULT_STEADY_INTERVAL, DEFAULT_STEADY_TOL, DEFAULT_T_END, DEFAULT_W, RESOLVED_LENGTH_ERROR,
+    RESOLVED_TAIL,
 )
 
 CONFIG_FILE = "sweep.json"
@@ -41,10 +42,20 @@ class Thresholds:
 
     tilt_change_deg: |θ_final − θ0| above which the tilt has changed.
     shape_change: |aspect ratio_final − aspect ratio_initial| above which the shape has.
+    resolved_length_error, resolved_tail: a case is resolved at its n when its worst
+    transient relative length error and its terminal spectral tail stay at or below
+    these (``config.RESOLVED_LENGTH_ERROR``, ``config.RESOLVED_TAIL``).
     """
 
     tilt_change_deg: float = 1.0
     shape_change: float = 0.01
+    resolved_length_error: float = RESOLVED_LENGTH_ERROR
+    resolved_tail: float = RESOLVED_TAIL
+
+    def resolved(self, length_error_max, spectral_tail):
+        """Whether a case with these diagnostics is resolved at its n."""
+        return bool(length_error_max <= self.resolved_length_error
+                    and spectral_tail <= self.resolved_tail)
 
 
 def classify(theta0_deg, theta_final_deg, aspect_initial, aspect_final, ok, thresholds=Thresholds()):
@@ -65,6 +76,9 @@ FIELD_NOTES = {
     "regime": "stable | in-plane | 3d | failed (see thresholds)",
     "stop_reason": "t_end | steady (terminal state reached early) | the failure",
     "length_error_max": "largest |relative length error| along the trajectory (transient)",
+    "resolved": "length_error_max <= thresholds.resolved_length_error and spectral_tail <= "
+                "thresholds.resolved_tail: n resolves the case (False: raise n; its terminal "
+                "outcome is not converged)",
 }
 
 
@@ -218,6 +232,7 @@ def _result_row(config, case_id, case, x0, x, status_code, counts, worst_length,
     row.update(
         case_id=case_id, aspect_ratio_initial=aspect0, x_final=x.ravel().tolist(),
         length_error_max=float(worst_length), stop_reason=integrators.STOP_REASONS[status_code],
+        resolved=config.thresholds.resolved(worst_length, row["spectral_tail"]),
         regime=classify(case["theta0_deg"], row["theta_final_deg"], aspect0, row["aspect_ratio"],
                         status_code in integrators.SUCCESS, config.thresholds),
     )

@@ -50,6 +50,7 @@ RESULT_SCHEMA = pa.schema(
         pa.field("stop_reason", pa.string()),
         pa.field("aspect_ratio_initial", _FLOAT),
         pa.field("length_error_max", _FLOAT),
+        pa.field("resolved", pa.bool_()),
         pa.field("x_final", pa.list_(_FLOAT)),
     ]
 )

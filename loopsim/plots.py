@@ -24,16 +24,23 @@ def _axes(ax, figsize):
 
 
 def phase_diagram(frame, ax=None):
-    """g0 against θ0 coloured by regime, with the curves g0 = 3 q_c / sin θ0 of the
+    """g0 against θ0 coloured by regime (hollow: the case is not resolved at its n, see
+    ``ensemble.Thresholds.resolved``), with the curves g0 = 3 q_c / sin θ0 of the
     paper's linear stability (q_c = 14.561, wrong sign) and of the full linearisation of
     the circle at the sweep's truncation (in-plane q_c ≈ 8.90, out-of-plane ≈ 10.65)."""
     fig, ax = _axes(ax, (6.6, 4.0))
     q_paper = paper.critical_q(20)
     order = int(frame["n"].max())
+    resolved = frame["resolved"] if "resolved" in frame else np.ones(len(frame), bool)
     for regime, style in REGIME_STYLE.items():
-        rows = frame[frame["regime"] == regime]
+        rows = frame[(frame["regime"] == regime) & resolved]
         if len(rows):
             ax.scatter(rows["theta0_deg"], rows["g0"], s=22, linewidths=1.2, **style)
+        rows = frame[(frame["regime"] == regime) & ~resolved]
+        if len(rows) and style["marker"] != "x":  # not resolved at n: hollow markers
+            ax.scatter(rows["theta0_deg"], rows["g0"], s=22, linewidths=1.0, marker=style["marker"],
+                       facecolors="none", edgecolors=style["color"],
+                       label=f"{style['label']}, not resolved at n")
     theta = np.linspace(1.0, 90.0, 300)
     ax.plot(theta, 3 * q_paper / np.sin(np.radians(theta)), "k-", lw=1.2,
             label=f"paper's linear\nstability, q = {q_paper:.3f}")

@@ -42,6 +42,33 @@ def test_classification_thresholds_are_parameters():
     assert ensemble.classify(30, 27, 1.0, 1.3, True, loose) == "stable"
 
 
+def test_resolved_flag_follows_both_thresholds():
+    """A case is resolved only with a small transient length error AND a small terminal
+    spectral tail (the two failure modes of scripts/resolution_study.py)."""
+    t = ensemble.Thresholds()
+    assert t.resolved(2e-7, 1e-8)
+    assert not t.resolved(1.5e-4, 1e-8)  # 3D at n = 6: length error, tiny tail
+    assert not t.resolved(2e-7, 1.2e-3)  # in-plane at n = 6: tail, no length error
+    assert ensemble.Thresholds(resolved_length_error=1e-3).resolved(1.5e-4, 1e-8)
+
+
+def test_sweep_marks_under_resolved_cases(tmp_path, capsys):
+    """n = 6: a stable loop is resolved; g0 = 150, θ0 = 60° (3D) is not (its length
+    error exceeds 1e-2 by t = 3), and the sweep's summary line says so."""
+    out = tmp_path / "res"
+    assert main(["sweep", "--g0", "30,150", "--theta0", "30,60", "--t-end", "3", "--quiet",
+                 "--out", str(out)]) == 0
+    frame = loopsim.read_results(str(out))
+    by_case = frame.set_index(["g0", "theta0_deg"])
+    assert by_case.loc[(30.0, 30.0), "resolved"]
+    assert not by_case.loc[(150.0, 60.0), "resolved"]
+    assert by_case.loc[(150.0, 60.0), "length_error_max"] > 1e-2
+    assert frame["resolved"].dtype == bool
+    stdout = capsys.readouterr().out
+    unresolved = int((~frame["resolved"]).sum())
+    assert f"{unresolved} of 4 cases NOT resolved" in stdout
+
+
 def test_parse_values():
     assert ensemble.parse_values("0:10:3", "--g0") == [0.0, 5.0, 10.0]
     assert ensemble.parse_values("6,8", "--n", integer=True) == [6, 8]
