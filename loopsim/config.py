@@ -39,11 +39,11 @@ DEFAULT_STEADY_TOL = 1e-6
 #: A run is *resolved* at its truncation n when its worst transient relative length
 #: error stays at or below RESOLVED_LENGTH_ERROR and its terminal spectral tail
 #: (``diagnostics.spectral_tail``) at or below RESOLVED_TAIL.  Evidence
-#: (scripts/resolution_study.py, n = 6 against n = 16 from the same start curve, 11
-#: cases g0 = 30..250, θ0 = 30..85°): the 3 cases whose terminal tilt and aspect ratio
-#: agree (to 4e-4° and 3e-7) had length errors ≤ 2e-7 and tails ≤ 1e-8; the 8 that
-#: differ (by 0.02 to 1.8 in aspect ratio, up to 62° in tilt) had length errors
-#: ≥ 1.5e-4, or (one in-plane case) a tail of 1.2e-3.  The tail alone is no guide: wrong
-#: 3D runs at n = 6 end as near-circles with tails of 1e-13.
+#: (scripts/resolution_study.py, n = 6 against n = 16 from the same start curve, 14
+#: cases g0 = 30..350, θ0 = 30..85°; table in the README): the 2 cases whose terminal
+#: tilt and aspect ratio agree (to 1e-4° and 3e-7) had length errors ≤ 1.5e-7 and tails
+#: ≤ 1.1e-8; the 12 that differ (by 0.02 to 3.8 in aspect ratio, up to 62° in tilt) had
+#: length errors ≥ 1.5e-4, or (g0 = 30, θ0 = 85°, in-plane) a tail of 1.2e-3.  The tail
+#: alone is no guide: wrong 3D runs at n = 6 end as near-circles with tails of 1e-13.
 RESOLVED_LENGTH_ERROR = 1e-5
 RESOLVED_TAIL = 1e-3
