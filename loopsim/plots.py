@@ -6,6 +6,7 @@ figure; none changes the matplotlib backend (the CLI chooses Agg).
 import matplotlib.pyplot as plt
 import numpy as np
 
+from . import spectral
 from .stability import circle, paper
 
 REGIME_STYLE = {
@@ -91,3 +92,26 @@ def save(fig, path, dpi=200):
     fig.savefig(path, dpi=dpi)
     plt.close(fig)
     return path
+
+
+def trajectory(frame, n, title="", axes=None):
+    """Snapshots of one run (a trajectory table: columns t, x, theta_deg, aspect_ratio):
+    left, the loop seen along x, centred on its centre of mass and coloured by time;
+    right, tilt and aspect ratio against time.  ``axes``: a pair, or None."""
+    if axes is None:
+        fig, axes = plt.subplots(1, 2, figsize=(9, 3.8), constrained_layout=True)
+    ax_shape, ax_time = axes
+    s = np.linspace(0.0, 2.0 * np.pi, 200)
+    colours = plt.cm.viridis(np.linspace(0.0, 1.0, max(len(frame), 1)))
+    for colour, coefficients in zip(colours, frame["x"]):
+        x = np.array(coefficients, dtype=float).reshape(3, 2 * n + 1)
+        x[:, 0] = 0.0  # centred: the mean coefficient is the centre of mass
+        points = spectral.evaluate(x, s)
+        ax_shape.plot(points[1], points[2], color=colour, lw=1)
+    ax_shape.set(xlabel="y (centred)", ylabel="z (centred)", aspect="equal", title=title)
+    ax_time.plot(frame["t"], frame["theta_deg"], label="tilt θ (deg)")
+    ax_ratio = ax_time.twinx()
+    ax_ratio.plot(frame["t"], frame["aspect_ratio"], color="C1", label="aspect ratio")
+    ax_time.set(xlabel="t", ylabel="tilt θ (deg)")
+    ax_ratio.set_ylabel("aspect ratio (variances)", color="C1")
+    return ax_shape.figure

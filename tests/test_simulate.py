@@ -144,3 +144,26 @@ def test_integrators_agree_on_an_in_plane_shape():
             for m in ("rkf45", "radau5")]
     assert all(r.success for r in runs) and runs[0].summary()["aspect_ratio"] > 1.3
     np.testing.assert_allclose(runs[1].x_final, runs[0].x_final, atol=1e-7)
+
+
+def test_trajectory_plot_is_centred_on_the_loop(tmp_path):
+    """The drawn shape lies within a few radii of the centre of mass, wherever the loop has
+    sedimented to (it falls ~ g0 t: here z ≈ -600; the old plot subtracted the mean from
+    every coefficient and spanned thousands)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import pyarrow.parquet as pq
+    from loopsim import plots
+
+    path = tmp_path / "run.parquet"
+    assert main(["run", "--g0", "60", "--theta0", "30", "--t-end", "10", "--snapshots", "5",
+                 "--out", str(path)]) == 0
+    frame = pq.read_table(path).to_pandas()
+    assert np.asarray(frame["x"].iloc[-1])[2 * 13] < -100  # z's mean coefficient: it fell
+    fig = plots.trajectory(frame, 6)
+    lines = fig.axes[0].get_lines()
+    assert len(lines) == 5
+    extent = max(np.abs(line.get_xydata()).max() for line in lines)
+    assert 0.5 < extent < 3.0  # unit radius, loop length 2π
+    plots.save(fig, tmp_path / "run.png")
+    assert (tmp_path / "run.png").stat().st_size > 0
