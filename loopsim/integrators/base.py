@@ -34,6 +34,14 @@ def advance(method, work, problem, y, f, h, h_proposal):
 
 
 @generic
+def dense_output(method, work, problem, y_old, f_old, y, f, h, theta, out):
+    """out = the state at t_old + theta h (0 < theta < 1) within the accepted step from
+    y_old (f_old = F(y_old)) to y (f = F(y)), by the method's dense output; returns the
+    RHS evaluations it cost.  It must not change what the next step does."""
+    raise NotImplementedError("only callable from jitted code")
+
+
+@generic
 def statistics(method, work):
     """(Jacobian evaluations, LU factorisations) made so far by the method."""
     raise NotImplementedError("only callable from jitted code")

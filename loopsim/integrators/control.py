@@ -157,33 +157,27 @@ def record_start(problem, y, t0, t_out, y_out, options):
 
 
 @numba.njit(**JIT)
-def landing(t, h, t_end, t_out, i_out):
-    """Step to try from t: h, shortened to land exactly on the next output time or t_end
-    (or stretched by up to LANDING_STRETCH rather than leave a sliver).
+def landing(t, h, t_end):
+    """Step to try from t: h, shortened to land exactly on t_end (or stretched by up to
+    LANDING_STRETCH rather than leave a sliver).  Output times are not landed on: they
+    come from the methods' dense output, so asking for output never changes the steps.
 
-    Returns (h_try, clipped, t_stop).
+    Returns (h_try, clipped).
     """
-    t_stop = t_end
-    if i_out < t_out.shape[0] and t_out[i_out] < t_stop:
-        t_stop = t_out[i_out]
-    if t + h * (1.0 + LANDING_STRETCH) >= t_stop:
-        return t_stop - t, True, t_stop
-    return h, False, t_stop
+    if t + h * (1.0 + LANDING_STRETCH) >= t_end:
+        return t_end - t, True
+    return h, False
 
 
 @numba.njit(**JIT)
-def monitor(problem, t, y, t_end, t_out, y_out, options, i_out, worst, next_check, previous,
-            quiet):
-    """After an accepted step: constraint error, outputs, steady state.
+def monitor(problem, t, y, t_end, options, worst, next_check, previous, quiet):
+    """After an accepted step: constraint error and steady state.
 
-    Returns (status or -1 to go on, i_out, worst, next_check, previous, quiet).
+    Returns (status or -1 to go on, worst, next_check, previous, quiet).
     """
     worst = max(worst, abs(constraint_error(problem, y)))
     if worst > options.constraint_tol:
-        return LENGTH_ERROR, i_out, worst, next_check, previous, quiet
-    while i_out < t_out.shape[0] and t_out[i_out] <= t:
-        y_out[i_out] = y
-        i_out += 1
+        return LENGTH_ERROR, worst, next_check, previous, quiet
     if options.steady_interval > 0.0 and t >= next_check and t < t_end:
         current = steady_invariants(problem, y)
         # change per steady_interval, whatever the steps' length since the last check
@@ -191,10 +185,10 @@ def monitor(problem, t, y, t_end, t_out, y_out, options, i_out, worst, next_chec
         change = max_abs_difference(current, previous) * options.steady_interval / elapsed
         quiet = quiet + 1 if change <= options.steady_tol else 0
         if quiet >= STEADY_WINDOWS:
-            return STEADY, i_out, worst, next_check, current, quiet
+            return STEADY, worst, next_check, current, quiet
         previous = current
         next_check = t + options.steady_interval
-    return -1, i_out, worst, next_check, previous, quiet
+    return -1, worst, next_check, previous, quiet
 
 
 @numba.njit(**JIT)

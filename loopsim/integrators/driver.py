@@ -1,9 +1,10 @@
 """One adaptive driver for every method: the loop around a method's step attempts.
 
 The driver owns what no method should repeat: the first right-hand side
-and step size, output at requested times (steps are shortened to land on
-them exactly), the step budget and underflow, the model's constraint and
-steady-state monitors, and the status.  It never raises: failures come back
+and step size, output at requested times (from the method's dense output:
+steps never land on output times, so asking for output leaves the
+trajectory bit-for-bit unchanged), the step budget and underflow, the
+model's constraint and steady-state monitors, and the status.  It never raises: failures come back
 as a status code (``integrators.control``).  The method-specific pieces
 (``start``, ``attempt``, ``advance``, see ``integrators.base``) are resolved on
 the method's type when the driver is compiled.
@@ -13,7 +14,7 @@ import numpy as np
 
 from ..config import JIT
 from ..models import rhs
-from .base import advance, attempt, start, statistics
+from .base import advance, attempt, dense_output, start, statistics
 from .control import (
     NON_FINITE, OK, all_finite, initial_step, landing, monitor, record_start, stop_check,
 )
@@ -41,7 +42,8 @@ def integrate(method, problem, y0, t0, t_end, t_out, options, y_out):
     (``control.step_options``).
 
     t_out: sorted output times in [t0, t_end]; the state at t_out[i] is written
-    to y_out[i].  Rows of y_out for times not reached are left untouched.
+    to y_out[i] (exactly at t0 and t_end, by the method's dense output between
+    steps).  Rows of y_out for times not reached are left untouched.
 
     Returns (status, t, y, counts, max_constraint_error): counts (int64) =
     [accepted steps, rejected steps, RHS evaluations, Jacobian evaluations, LU
@@ -54,6 +56,8 @@ def integrate(method, problem, y0, t0, t_end, t_out, options, y_out):
     y = y0.copy()
     f = np.empty(ny)
     y_new = np.empty(ny)
+    y_old = np.empty(ny)
+    f_old = np.empty(ny)
     n_acc = 0
     n_rej = 0
     worst = 0.0
@@ -76,7 +80,7 @@ def integrate(method, problem, y0, t0, t_end, t_out, options, y_out):
         stop = stop_check(options, n_acc + n_rej, h, t, y)
         if stop >= 0:
             return stop, t, y, _counts(method, work, counts, n_acc, n_rej, n_rhs), worst
-        h_try, clipped, t_stop = landing(t, h, t_end, t_out, i_out)
+        h_try, clipped = landing(t, h, t_end)
         accepted, h_next, evals = attempt(method, work, problem, y, f, h_try, y_new, options)
         n_rhs += evals
         if not accepted:
@@ -84,18 +88,27 @@ def integrate(method, problem, y0, t0, t_end, t_out, options, y_out):
             h = h_next
             continue
         n_acc += 1
-        t = t_stop if clipped else t + h_try
+        t_old = t
+        t = t_end if clipped else t + h_try
+        y_old[:] = y
+        f_old[:] = f
         y[:] = y_new
         rhs(problem, y, f)
         n_rhs += 1
         if not all_finite(f):
             return NON_FINITE, t, y, _counts(method, work, counts, n_acc, n_rej, n_rhs), worst
-        stop, i_out, worst, next_check, previous, quiet = monitor(
-            problem, t, y, t_end, t_out, y_out, options, i_out, worst, next_check, previous, quiet)
+        while i_out < t_out.shape[0] and t_out[i_out] <= t:
+            if t_out[i_out] == t:
+                y_out[i_out] = y
+            else:
+                n_rhs += dense_output(method, work, problem, y_old, f_old, y, f, h_try,
+                                      (t_out[i_out] - t_old) / h_try, y_out[i_out])
+            i_out += 1
+        stop, worst, next_check, previous, quiet = monitor(
+            problem, t, y, t_end, options, worst, next_check, previous, quiet)
         if stop >= 0:
             return stop, t, y, _counts(method, work, counts, n_acc, n_rej, n_rhs), worst
         h_next, evals = advance(method, work, problem, y, f, h_try, h_next)
         n_rhs += evals
-        # a step shortened to hit an output time says nothing about the next h
-        h = min(options.max_step, max(h, h_next) if clipped else h_next)
+        h = min(options.max_step, h_next)
     return OK, t, y, _counts(method, work, counts, n_acc, n_rej, n_rhs), worst

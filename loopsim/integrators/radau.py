@@ -29,7 +29,7 @@ import numpy as np
 
 from ..config import JIT
 from ..models import jacobian, rhs
-from .base import advance, attempt, implements, start, statistics
+from .base import advance, attempt, dense_output, implements, start, statistics
 from .control import MAX_FACTOR, MIN_FACTOR, SAFETY, rms_norm
 from ..linalg import PIVOT_DTYPE, lu_factor, lu_solve
 
@@ -304,6 +304,7 @@ def _radau_attempt(method, work, problem, y, f, h, y_new, options):
         factor = 1.0  # keep h, and with it the LU factors
     s[ERR_NORM] = err_norm
     s[RECOMPUTE_JAC] = 1.0 if recompute_jac else 0.0
+    collocation_polynomial(work.z, work.poly)  # dense output, and the next Newton start
     return True, h * factor, evals
 
 
@@ -318,10 +319,18 @@ def _radau_advance(method, work, problem, y, f, h, h_proposal):
         s[H_LU] = -1.0
     else:
         s[JAC_CURRENT] = 0.0
-    collocation_polynomial(work.z, work.poly)
     s[H_OLD] = h
     s[ERR_OLD] = s[ERR_NORM]
     return h_proposal, evals
+
+
+@implements(dense_output, RadauIIA)
+def _radau_dense_output(method, work, problem, y_old, f_old, y, f, h, theta, out):
+    """The collocation polynomial of the step: y_old + Σ_k q_k θ^(k+1) (order 3)."""
+    q = work.poly
+    for i in range(y.shape[0]):
+        out[i] = y_old[i] + theta * (q[0, i] + theta * (q[1, i] + theta * q[2, i]))
+    return 0
 
 
 @implements(statistics, RadauIIA)
