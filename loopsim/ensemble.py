@@ -10,7 +10,6 @@ refused.  No numerics here: integration is ``batch``, start shapes
 ``shapes``, summaries ``api``, tables ``io``.
 """
 import dataclasses
-import glob
 import itertools
 import json
 import math
@@ -30,8 +29,8 @@ from .config import (
 )
 
 CONFIG_FILE = "sweep.json"
-CHUNK_PATTERN = "chunk-{:05d}.parquet"
-SNAPSHOT_PATTERN = "snapshots-{:05d}.parquet"
+CHUNK_PATTERN = io.CHUNK_PATTERN
+SNAPSHOT_PATTERN = io.SNAPSHOT_PATTERN
 REGIMES = ("stable", "in-plane", "3d", "failed")
 
 
@@ -331,9 +330,9 @@ class Progress:
 
 
 def _prepare_directory(out, config, command_line):
+    """Create or check ``out``: a sweep directory holds one configuration only.  Nothing
+    is removed unless the configuration matches, and then only dead processes' temporaries."""
     os.makedirs(out, exist_ok=True)
-    for stale in glob.glob(os.path.join(out, ".tmp-*")):  # a write cut short by a kill
-        os.remove(stale)
     path = os.path.join(out, CONFIG_FILE)
     stored = dict(config=config.as_dict(), command_line=command_line)
     if os.path.exists(path):
@@ -344,6 +343,9 @@ def _prepare_directory(out, config, command_line):
             changed = sorted(k for k in set(previous) | set(current) if previous.get(k) != current.get(k))
             raise ValueError(f"{out!r} holds a different sweep (differs in: {', '.join(changed)}); "
                              "use another --out")
+    _check_chunks_belong(out, config)
+    io.remove_stale_temporaries(out)
+    if os.path.exists(path):
         return
     tmp = path + ".tmp"
     with open(tmp, "w") as handle:
@@ -351,8 +353,19 @@ def _prepare_directory(out, config, command_line):
     os.replace(tmp, path)
 
 
+def _check_chunks_belong(out, config):
+    """Refuse a directory whose chunk files were written by another sweep (a lost or
+    replaced sweep.json must not make old rows pass for new ones)."""
+    current = json.loads(json.dumps(config.as_dict()))
+    for chunk, path in io.numbered_files(out).items():
+        stored = io.read_metadata(path).get("sweep_config")
+        if stored != current or chunk >= config.n_chunks:
+            raise ValueError(f"{path!r} belongs to a different sweep than this command's; "
+                             "use another --out, or move that file away")
+
+
 def finished_chunks(out):
-    return {int(os.path.basename(p)[6:11]) for p in glob.glob(os.path.join(out, "chunk-*.parquet"))}
+    return set(io.numbered_files(out))
 
 
 def run_sweep(config, out, threads=None, quiet=False, command_line=None):

@@ -8,7 +8,10 @@ import datetime
 import glob
 import json
 import os
+import re
+import socket
 import tempfile
+import warnings
 
 import numba
 import numpy as np
@@ -71,10 +74,59 @@ def provenance(**extra):
             for key, value in meta.items()}
 
 
+#: Files of a sweep directory: chunk k and its snapshots, named exactly so.
+CHUNK_PATTERN = "chunk-{:05d}.parquet"
+SNAPSHOT_PATTERN = "snapshots-{:05d}.parquet"
+_CHUNK_NAME = re.compile(r"chunk-(\d{5})\.parquet")
+_SNAPSHOT_NAME = re.compile(r"snapshots-(\d{5})\.parquet")
+#: Temporary files are named .tmp-HOST-PID-*: only their owner, or a later process on the
+#: same host once the owner has died, may remove them.
+_TEMP_NAME = re.compile(r"\.tmp-(?P<host>.+)-(?P<pid>\d+)-[^-]*$")
+
+
+def _temporary_prefix():
+    return f".tmp-{socket.gethostname()}-{os.getpid()}-"
+
+
+def remove_stale_temporaries(directory):
+    """Remove the temporary files in ``directory`` left by dead processes on this host
+    (a write cut short by a kill); files of live processes and other hosts stay."""
+    host = socket.gethostname()
+    for path in glob.glob(os.path.join(directory, ".tmp-*")):
+        match = _TEMP_NAME.match(os.path.basename(path))
+        if match is None or match["host"] != host:
+            continue
+        try:
+            os.kill(int(match["pid"]), 0)
+        except ProcessLookupError:
+            try:
+                os.remove(path)
+            except FileNotFoundError:
+                pass
+        except PermissionError:  # alive, another user's
+            pass
+
+
+def numbered_files(directory, kind="chunk"):
+    """{k: path} of the chunk (or ``kind="snapshots"``) files of a sweep directory, named
+    exactly ``chunk-KKKKK.parquet``; any other ``chunk-*`` file (a stray copy) is ignored
+    with a warning naming it."""
+    pattern = _CHUNK_NAME if kind == "chunk" else _SNAPSHOT_NAME
+    found = {}
+    for path in sorted(glob.glob(os.path.join(directory, f"{kind}-*"))):
+        match = pattern.fullmatch(os.path.basename(path))
+        if match is None:
+            warnings.warn(f"ignoring {path!r}: not a {kind} file of this sweep (stray copy?)",
+                          stacklevel=2)
+            continue
+        found[int(match[1])] = path
+    return found
+
+
 def write_table_atomically(table, path):
     """Write to a temporary file in the target directory, then rename into place."""
     directory = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(prefix=".tmp-", suffix=".parquet", dir=directory)
+    fd, tmp = tempfile.mkstemp(prefix=_temporary_prefix(), suffix=".parquet", dir=directory)
     os.close(fd)
     try:
         pq.write_table(table, tmp)
@@ -126,7 +178,7 @@ def read_metadata(path):
 
 def read_snapshots(out):
     """Trajectory snapshots of the cases chosen with ``snapshots_for`` (a DataFrame)."""
-    paths = sorted(glob.glob(os.path.join(out, "snapshots-*.parquet")))
+    paths = sorted(numbered_files(out, "snapshots").values()) if os.path.isdir(out) else []
     if not paths:
         return pd.DataFrame()
     frame = pa.concat_tables([pq.read_table(p) for p in paths]).to_pandas()
@@ -139,12 +191,24 @@ def read_results(out):
     The sweep's metadata (configuration, thresholds, versions, command line)
     is in ``frame.attrs["loopsim"]``.
     """
-    paths = sorted(glob.glob(os.path.join(out, "chunk-*.parquet")))
     if not os.path.isdir(out):
         raise ValueError(f"no sweep directory at {out!r}")
+    paths = sorted(numbered_files(out).values())
     if not paths:
         return RESULT_SCHEMA.empty_table().to_pandas()
+    configs = {p: read_metadata(p).get("sweep_config") for p in paths}
+    if len({json.dumps(c, sort_keys=True) for c in configs.values()}) > 1:
+        first = paths[0]
+        other = next(p for p in paths if configs[p] != configs[first])
+        raise ValueError(f"{out!r} mixes sweeps: {os.path.basename(other)!r} has another "
+                         f"configuration than {os.path.basename(first)!r}; move the foreign "
+                         "files away")
     table = pa.concat_tables([pq.read_table(p, schema=RESULT_SCHEMA) for p in paths])
     frame = table.to_pandas().sort_values("case_id", kind="stable").reset_index(drop=True)
+    duplicated = frame["case_id"][frame["case_id"].duplicated()]
+    if len(duplicated):
+        raise ValueError(f"{out!r} holds case_id {int(duplicated.iloc[0])} more than once "
+                         f"({len(duplicated)} duplicate rows): a chunk file was copied or "
+                         "renamed; move the extra files away")
     frame.attrs["loopsim"] = read_metadata(paths[0])
     return frame

@@ -200,3 +200,53 @@ def test_snapshots_for_unknown_case_is_refused(tmp_path, capsys):
                  "--out", str(tmp_path / "s")])
     err = capsys.readouterr().err
     assert code == 2 and "case 5" in err
+
+
+# ---- a sweep directory holds one sweep, whole ---------------------------------------
+
+def _fast_sweep_argv(out, g0="10,60"):
+    return ["sweep", "--g0", g0, "--theta0", "30", "--n", "4", "--t-end", "0.2",
+            "--chunk-size", "1", "--quiet", "--out", str(out)]
+
+
+def test_refused_sweep_leaves_live_temporaries_alone(tmp_path, capsys):
+    """A second sweep refused for another configuration must not delete the temporary
+    files of a sweep still writing (it used to remove every .tmp-*); a dead process's
+    temporary is cleaned by the next run of the same sweep."""
+    import socket
+    out = tmp_path / "s"
+    assert main(_fast_sweep_argv(out)) == 0
+    host = socket.gethostname()
+    live = out / f".tmp-{host}-{os.getpid()}-abc.parquet"  # this process: alive
+    live.write_bytes(b"partial")
+    child = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                           capture_output=True, text=True, check=True)
+    dead = out / f".tmp-{host}-{int(child.stdout)}-abc.parquet"
+    dead.write_bytes(b"partial")
+    assert main(_fast_sweep_argv(out, g0="20,70")) == 2  # refused: another sweep
+    assert live.exists() and dead.exists()
+    assert main(_fast_sweep_argv(out)) == 0  # the same sweep again: resumes, cleans
+    assert live.exists() and not dead.exists()
+
+
+def test_foreign_and_duplicate_chunks_are_refused(tmp_path, capsys):
+    """Rows of another sweep never pass for this one's, and a case is never read twice."""
+    out = tmp_path / "s"
+    assert main(_fast_sweep_argv(out)) == 0
+    frame = loopsim.read_results(str(out))
+    assert list(frame["case_id"]) == [0, 1]
+    # a lost sidecar, then a different sweep into the same directory: refused
+    (out / "sweep.json").unlink()
+    assert main(_fast_sweep_argv(out, g0="20,70")) == 2
+    assert "belongs to a different sweep" in capsys.readouterr().err
+    assert not (out / "sweep.json").exists()
+    # a stray copy is ignored with a warning (no duplicate rows)
+    (out / "chunk-00001 (copy).parquet").write_bytes((out / "chunk-00001.parquet").read_bytes())
+    with pytest.warns(UserWarning, match="stray copy"):
+        frame = loopsim.read_results(str(out))
+    assert list(frame["case_id"]) == [0, 1]
+    # a copy under a valid chunk name duplicates case ids: refused on read and on resume
+    (out / "chunk-00001 (copy).parquet").rename(out / "chunk-00005.parquet")
+    with pytest.raises(ValueError, match="more than once"):
+        loopsim.read_results(str(out))
+    assert main(_fast_sweep_argv(out)) == 2
