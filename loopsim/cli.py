@@ -206,8 +206,10 @@ def _format_initial(info):
 
 
 def _cmd_run(args):
-    from . import api, ensemble, io
+    from . import api, ensemble, io, validation
 
+    if args.out is not None:
+        validation.check_output_file("--out", args.out)
     g0, start, info = args.g0, None, None
     if args.initial is not None:
         start, info, g0 = _load_initial_for_run(args)
@@ -247,8 +249,10 @@ def _cmd_run(args):
 
 
 def _cmd_sweep(args):
-    from . import ensemble, plots
+    from . import ensemble, plots, validation
 
+    if args.figure is not None:
+        validation.check_output_file("--figure", args.figure)
     if args.cases:
         if args.g0 or args.theta0:
             raise ValueError("give either --cases or --g0/--theta0, not both")
@@ -295,9 +299,11 @@ FULL_ONLY = ("n", "theta0", "w", "q_scan", "g0", "top", "onset", "figure")
 
 
 def _cmd_stability_full(args):
-    from . import ensemble, plots
+    from . import ensemble, plots, validation
     from .stability import circle, onset, paper
 
+    if args.figure is not None:
+        validation.check_output_file("--figure", args.figure)
     if args.n_max is not None:
         raise ValueError("--n-max applies only to the --paper table")
     for key, value in FULL_DEFAULTS.items():

@@ -1,6 +1,7 @@
 """Input checks shared by every entry point: one-line ``ValueError``s naming the value."""
 import math
 import numbers
+import os
 
 import numpy as np
 
@@ -30,6 +31,22 @@ def check_choice(name, value, choices):
     if value not in choices:
         raise ValueError(f"{name} must be one of {sorted(choices)}, got {value!r}")
     return value
+
+
+def check_output_file(name, path):
+    """A file path that can be written: its directory exists and is writable, and the path
+    is not a directory.  Checked before any work, so no run is lost to a bad --out."""
+    path = os.fspath(path)
+    if not path:
+        raise ValueError(f"{name} is empty")
+    directory = os.path.dirname(os.path.abspath(path))
+    if os.path.isdir(path):
+        raise ValueError(f"{name} {path!r} is a directory")
+    if not os.path.isdir(directory):
+        raise ValueError(f"{name} {path!r}: no such directory {directory!r}")
+    if not os.access(directory, os.W_OK | os.X_OK):
+        raise ValueError(f"{name} {path!r}: directory {directory!r} is not writable")
+    return path
 
 
 def check_tilt(name, value, allow_zero=True):

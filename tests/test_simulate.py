@@ -167,3 +167,25 @@ def test_trajectory_plot_is_centred_on_the_loop(tmp_path):
     assert 0.5 < extent < 3.0  # unit radius, loop length 2π
     plots.save(fig, tmp_path / "run.png")
     assert (tmp_path / "run.png").stat().st_size > 0
+
+
+@pytest.mark.parametrize("argv", [
+    ["run", "--g0", "60", "--theta0", "30", "--out", "{tmp}/missing/run.parquet"],
+    ["run", "--g0", "60", "--theta0", "30", "--out", "{tmp}"],
+    ["run", "--g0", "60", "--theta0", "30", "--out", ""],
+    ["sweep", "--g0", "60", "--theta0", "30", "--out", "{tmp}/s", "--figure", "{tmp}/missing/p.png"],
+])
+def test_output_paths_are_checked_before_any_work(argv, tmp_path, capsys, monkeypatch):
+    """A bad --out or --figure is refused before any integration (one line, exit 2)."""
+    from loopsim import ensemble
+
+    def no_work(*args, **kwargs):
+        raise AssertionError("integration started before the output path was checked")
+
+    monkeypatch.setattr(api, "simulate", no_work)
+    monkeypatch.setattr(ensemble, "run_sweep", no_work)
+    argv = [a.replace("{tmp}", str(tmp_path)) for a in argv]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1 and err.startswith("loopsim: error:")
+    assert not (tmp_path / "s").exists()  # nothing created for a refused sweep
