@@ -180,8 +180,10 @@ def length_creation(x, tension, g0, w, ops, ws):
 def relative_length_error(x, ops, ws):
     """(L - 2π) / 2π with L = ∫|x'| ds by the trapezoid rule on the M-point grid.
 
-    |x'| is smooth and periodic, so the rule converges spectrally; for a
-    nearly inextensible loop it is exact far below the tolerances used.
+    |x'| is smooth and periodic, so the rule converges spectrally, but |x'| is
+    not a trigonometric polynomial: against a 256-point grid, random smooth shapes
+    (amplitude 0.1) differ by up to 3.5e-8 at n = 6, 1.3e-10 at n = 8 and 1.1e-11 at
+    n = 10 (tests/test_twins.py); near unit speed the error is far smaller.
     """
     np.dot(x, ops.S1T, ws.tangent)
     total = 0.0
