@@ -249,10 +249,15 @@ def _cmd_run(args):
 
 
 def _cmd_sweep(args):
+    import numba
+
     from . import ensemble, plots, validation
 
     if args.figure is not None:
         validation.check_output_file("--figure", args.figure)
+    if args.threads is not None and not 1 <= args.threads <= numba.config.NUMBA_NUM_THREADS:
+        raise ValueError(f"--threads must be in 1..{numba.config.NUMBA_NUM_THREADS} (the "
+                         f"cores Numba may use), got {args.threads}")
     if args.cases:
         if args.g0 or args.theta0:
             raise ValueError("give either --cases or --g0/--theta0, not both")
@@ -266,8 +271,6 @@ def _cmd_sweep(args):
         cases = ensemble.grid_cases(
             ensemble.parse_values(args.g0, "--g0"), ensemble.parse_values(args.theta0, "--theta0"),
             ensemble.parse_values(args.n, "--n", integer=True), args.seeds, args.perturbation)
-    if args.threads is not None and args.threads < 1:
-        raise ValueError(f"--threads must be >= 1, got {args.threads}")
     config = ensemble.SweepConfig(cases=cases, t_end=args.t_end, rtol=args.rtol, atol=args.atol,
                                   w=args.w, method=args.method, chunk_size=args.chunk_size,
                                   early_stop=not args.no_early_stop,

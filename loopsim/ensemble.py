@@ -145,6 +145,30 @@ def grid_cases(g0_values, theta0_values, n_values, seeds, perturbation=DEFAULT_P
     ]
 
 
+def _cell(path, row, column, value, integer):
+    """One value of a cases file as float or int, or a one-line error naming file, row
+    (counted from 0, as in pandas) and column."""
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"cases file {path!r}, row {row}, column {column}: not a number: "
+                         f"{value!r}") from None
+    if integer:
+        if not number.is_integer():
+            raise ValueError(f"cases file {path!r}, row {row}, column {column}: must be an "
+                             f"integer, got {value!r}")
+        return int(number)
+    return number
+
+
+def _case_row(path, i, row):
+    """A case dict from one row of a cases file (types checked, cell by cell)."""
+    return dict(g0=_cell(path, i, "g0", row.g0, False),
+                theta0_deg=_cell(path, i, "theta0_deg", row.theta0_deg, False),
+                n=_cell(path, i, "n", row.n, True), seed=_cell(path, i, "seed", row.seed, True),
+                perturbation=_cell(path, i, "perturbation", row.perturbation, False))
+
+
 def read_cases_file(path, perturbation=DEFAULT_PERTURBATION, n=6):
     """Cases from a CSV or Parquet table: columns g0, theta0_deg (required), n, seed, perturbation."""
     try:
@@ -158,8 +182,7 @@ def read_cases_file(path, perturbation=DEFAULT_PERTURBATION, n=6):
     given = frame.notna() if "initial" in frame.columns else None  # per-cell: value given?
     frame = frame.assign(**{k: v for k, v in dict(n=n, seed=0, perturbation=perturbation,
                                                   theta0_deg=math.nan).items() if k not in frame})
-    cases = [dict(g0=float(r.g0), theta0_deg=float(r.theta0_deg), n=int(r.n), seed=int(r.seed),
-                  perturbation=float(r.perturbation)) for r in frame.itertuples()]
+    cases = [_case_row(path, i, row) for i, row in enumerate(frame.itertuples())]
     for i, case in enumerate(cases):  # optional column initial (file or results), initial_case_id
         if given is not None and given["initial"].iloc[i] and str(frame["initial"].iloc[i]).strip():
             case_id = frame["initial_case_id"].iloc[i] if "initial_case_id" in frame else None

@@ -250,3 +250,24 @@ def test_foreign_and_duplicate_chunks_are_refused(tmp_path, capsys):
     with pytest.raises(ValueError, match="more than once"):
         loopsim.read_results(str(out))
     assert main(_fast_sweep_argv(out)) == 2
+
+
+@pytest.mark.parametrize("content, words", [
+    ("g0,theta0_deg,n\n60,30,6.5\n", ["row 0", "column n", "integer", "6.5"]),
+    ("g0,theta0_deg\n60,30\nten,30\n", ["row 1", "column g0", "'ten'"]),
+])
+def test_cases_file_cells_are_checked(tmp_path, capsys, content, words):
+    """n = 6.5 is refused (it used to run n = 6), and a bad cell names row and column."""
+    path = tmp_path / "cases.csv"
+    path.write_text(content)
+    assert main(["sweep", "--cases", str(path), "--out", str(tmp_path / "s")]) == 2
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1 and all(word in err for word in words), err
+    assert not (tmp_path / "s").exists()
+
+
+def test_too_many_threads_refused_before_the_directory_is_made(tmp_path, capsys):
+    out = tmp_path / "s"
+    assert main(["sweep", "--g0", "60", "--theta0", "30", "--threads", "1000",
+                 "--out", str(out)]) == 2
+    assert "--threads" in capsys.readouterr().err and not out.exists()
