@@ -4,10 +4,11 @@ The driver owns what no method should repeat: the first right-hand side
 and step size, output at requested times (from the method's dense output:
 steps never land on output times, so asking for output leaves the
 trajectory bit-for-bit unchanged), the step budget and underflow, the
-model's constraint and steady-state monitors, and the status.  It never raises: failures come back
-as a status code (``integrators.control``).  The method-specific pieces
-(``start``, ``attempt``, ``advance``, see ``integrators.base``) are resolved on
-the method's type when the driver is compiled.
+model's constraint and steady-state monitors, and the status.  It never
+raises: failures come back as a status code (``integrators.control``).  The
+method-specific pieces (``start``, ``attempt``, ``advance``, ``dense_output``,
+``statistics``; see ``integrators.base``) are resolved on the method's type
+when the driver is compiled.
 """
 import numba
 import numpy as np
