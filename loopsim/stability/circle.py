@@ -402,7 +402,7 @@ def critical_q_table(n_values, theta0_deg=90.0, w=DEFAULT_W):
 # ---------------------------------------------------------------- comparison with the paper
 def paper_comparison(q_values, n, theta0_deg=90.0, w=DEFAULT_W):
     """Rows dict(q, paper, corrected, out_of_plane, in_plane): largest growth rates of the
-    paper's operator (linear_stability), the corrected operator, and the full Jacobian's sectors."""
+    paper's operator and the corrected one (``stability.paper``), and the full Jacobian's sectors."""
     rates = sector_growth_rates(q_values, n, theta0_deg, w)
     rows = []
     for i, q in enumerate(np.asarray(q_values, dtype=float).ravel()):
