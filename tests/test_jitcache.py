@@ -1,7 +1,7 @@
-"""The compiled-kernel cache is keyed by the whole package source."""
+"""The compiled-kernel cache is keyed by the source of every module a kernel can reach."""
 import numba
 
-import loopsim
+from loopsim import batch
 from loopsim import _jitcache  # noqa: the cache guard is tested as a unit
 
 
@@ -14,8 +14,21 @@ def test_cache_directory_follows_the_source(tmp_path):
     assert _jitcache.source_hash([str(a), str(b)]) != before
     assert numba.config.CACHE_DIR == _jitcache.cache_dir()
     assert numba.config.CACHE_DIR.endswith("numba-" + _jitcache.source_hash())
-    # subpackages count: an integrator or model edit must start a fresh cache
-    sources = _jitcache.package_sources()
-    assert any(p.endswith("integrators/driver.py") for p in sources)
-    assert any(p.endswith("models/local_sbt.py") for p in sources)
-    assert loopsim.batch.parallel_cases._cache._cache_path.startswith(numba.config.CACHE_DIR)
+    # subpackages count: an integrator or model edit must start a fresh cache, and so
+    # must an edit to a module a kernel module imports (local_sbt imports spectral)
+    sources = [p.replace("\\", "/") for p in _jitcache.kernel_sources()]
+    for module in ("integrators/driver.py", "integrators/radau.py", "models/local_sbt.py",
+                   "linalg.py", "batch.py", "spectral.py", "config.py"):
+        assert any(p.endswith("loopsim/" + module) for p in sources), module
+    # orchestration that no kernel imports does not invalidate the compiled kernels
+    for module in ("cli.py", "ensemble.py", "plots.py"):
+        assert not any(p.endswith("loopsim/" + module) for p in sources), module
+
+
+def test_kernel_sources_are_closed_under_imports():
+    """Every package module imported by a module in the hashed set is in the set."""
+    known = {_jitcache.module_name(p): p for p in _jitcache.package_sources()}
+    hashed = {_jitcache.module_name(p) for p in _jitcache.kernel_sources()}
+    for name in hashed:
+        assert _jitcache.imported_modules(name, known[name], known) <= hashed, name
+    assert batch.parallel_cases._cache._cache_path.startswith(numba.config.CACHE_DIR)
