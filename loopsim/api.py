@@ -11,10 +11,10 @@ import time
 
 import numpy as np
 
-from . import diagnostics, integrators, io, models, shapes, validation
+from . import diagnostics, integrators, io, models, refinement, shapes, validation
 from .config import (
-    DEFAULT_ATOL, DEFAULT_LENGTH_TOL, DEFAULT_MAX_STEPS, DEFAULT_RTOL, DEFAULT_SEED,
-    DEFAULT_STEADY_INTERVAL, DEFAULT_T_END, DEFAULT_W,
+    DEFAULT_ATOL, DEFAULT_LENGTH_TOL, DEFAULT_MAX_STEPS, DEFAULT_N_MAX, DEFAULT_RTOL,
+    DEFAULT_SEED, DEFAULT_STEADY_INTERVAL, DEFAULT_T_END, DEFAULT_TAIL_TOL, DEFAULT_W,
 )
 from .diagnostics import stability_parameter
 
@@ -29,13 +29,15 @@ class SimulationResult:
     """One trajectory: inputs, states at the requested times, the final state, statistics.
 
     ``t`` holds exactly the requested times that were reached (``t_missed`` the
-    others, after an early stop or a failure); ``x[i]`` (3, 2n+1) are the
+    others, after an early stop or a failure); ``x[i]`` (3, 2 n_used + 1) are the
     position coefficients at ``t[i]``, ``u[i]`` the velocity and
     ``multiplier[i]`` (2n+1) the tension multiplier T there (``spectral``
     layout); ``y`` is ``x`` flattened as solve_ivp's (n_state, n_times).  The
     final state, at ``t_final``, is ``x_final``, ``u_final``,
     ``multiplier_final``.  ``tension_profile(i)`` gives the physical axial
-    force N(s).
+    force N(s).  ``n_used`` is the truncation the run ended at (with ``n="auto"``
+    earlier states are zero-padded to it), ``tail_max`` the largest spectral tail met
+    at n_used.
     """
 
     inputs: dict
@@ -57,6 +59,8 @@ class SimulationResult:
     nlu: int
     wall_s: float
     length_error_max: float  # largest |relative length error| at accepted steps
+    n_used: int = None
+    tail_max: float = float("nan")
     initial_info: dict = None  # diagnostics of a given initial shape (``shapes``), else None
 
     @property
@@ -101,9 +105,11 @@ class SimulationResult:
         """Dict with exactly the keys of ``SUMMARY_FIELDS`` (the final state's diagnostics)."""
         return terminal_summary(
             self.inputs, self.x_final, self.u_final, self.multiplier_final,
+            method=self.method, n_used=self.n_used,
             status=integrators.STATUS_NAMES[self.status_code], t_final=self.t_final,
             steps_accepted=self.steps_accepted, steps_rejected=self.steps_rejected,
-            nfev=self.nfev, njev=self.njev, nlu=self.nlu, wall_s=self.wall_s)
+            nfev=self.nfev, njev=self.njev, nlu=self.nlu, wall_s=self.wall_s,
+            tail_max=self.tail_max)
 
 
 def terminal_summary(inputs, x, u, multiplier, **run_stats):
@@ -140,7 +146,7 @@ def simulate(
     perturbation=None, seed=DEFAULT_SEED, method="rkf45",
     max_steps=DEFAULT_MAX_STEPS, length_tol=DEFAULT_LENGTH_TOL, first_step=None,
     max_step=math.inf, min_step=0.0, steady_tol=None, steady_interval=DEFAULT_STEADY_INTERVAL,
-    initial=None, initial_case_id=None,
+    initial=None, initial_case_id=None, n_max=DEFAULT_N_MAX, tail_tol=DEFAULT_TAIL_TOL,
 ):
     """Simulate a loop released as a perturbed circle tilted by ``theta0_deg``.
 
@@ -152,7 +158,10 @@ def simulate(
     steady terminal state (``integrators.step_options``).  ``g0`` is gravity
     over stiffness, ``w`` the length-penalty rate, ``perturbation`` the RMS
     size of the seeded initial perturbation (``shapes.circle``; default 1e-3,
-    n = 6).
+    n = 6).  ``n="auto"`` starts at n = 6 (or a given shape's order) and raises n
+    up to ``n_max`` whenever the spectral tail passes ``tail_tol``
+    (``loopsim.refinement``).  ``method="auto"`` picks the integrator for the case
+    (``refinement.auto_method``).
 
     ``initial`` starts from a given shape instead of the tilted circle:
     coefficients (3, 2m+1) or a path (point file or results, with
@@ -162,10 +171,19 @@ def simulate(
     Never raises for a failed integration: see ``result.success``.
     """
     g0 = validation.check_real("g0", g0, low=0.0)
-    method_object = integrators.METHODS[validation.check_choice("method", method,
-                                                                 integrators.METHODS)]
+    method = validation.check_choice("method", method, refinement.METHOD_CHOICES)
+    refine = isinstance(n, str)
+    if refine:
+        validation.check_choice("n", n, ("auto",))
+        tail_tol = validation.check_real("tail_tol", tail_tol, low=0.0, low_open=True)
     x0, theta0_deg, n, perturbation, initial_info = shapes.start_shape(
-        theta0_deg, n, perturbation, seed, initial, initial_case_id)
+        theta0_deg, refinement.AUTO_START if refine and initial is None else
+        (None if refine else n), perturbation, seed, initial, initial_case_id)
+    ladder = refinement.orders(n, max(n, validation.check_integer("n_max", n_max, 1))) \
+        if refine else (n,)
+    if method == "auto":
+        method = refinement.auto_method(stability_parameter(g0, theta0_deg), n, refine)
+    method_object = integrators.METHODS[method]
     t0, t_end = (validation.check_real("t_span[0]", t_span[0]),
                  validation.check_real("t_span[1]", t_span[1]))
     if not t_end > t0:
@@ -191,27 +209,26 @@ def simulate(
 
     inputs = dict(g0=g0, theta0_deg=theta0_deg, n=n, t_end=t_end, rtol=rtol, atol=atol,
                   w=w, perturbation=perturbation, seed=int(seed))
-    problem = models.local_sbt.make_problem(n, g0, w)
-    y_out = np.full((t_eval.size, x0.size), np.nan)
     options = integrators.step_options(
         rtol, atol, first_step, min_step, max_step, max_steps, length_tol,
         steady_interval if steady_tol is not None else 0.0, steady_tol or 0.0)
     start = time.perf_counter()
-    status, t_final, y_final, counts, worst_length = integrators.integrate(
-        method_object, problem, x0.ravel(), t0, t_end, t_eval, options, y_out)
+    status, t_final, x_final, n_used, counts, worst, x_out = refinement.integrate_case(
+        method_object, g0, w, x0, t0, t_end, t_eval, options, ladder, tail_tol)
     wall = time.perf_counter() - start
 
+    problem = models.local_sbt.make_problem(n_used, g0, w)
     reached = t_eval <= t_final
-    x = y_out[reached].reshape(-1, 3, x0.shape[1])
+    x = x_out[reached]
     u = np.empty_like(x)
-    multiplier = np.empty((x.shape[0], x0.shape[1]))
+    multiplier = np.empty((x.shape[0], x_final.shape[1]))
     for i in range(x.shape[0]):
         u[i], multiplier[i] = velocity_and_multiplier(problem, x[i])
-    x_final = y_final.reshape(3, -1)
     u_final, multiplier_final = velocity_and_multiplier(problem, x_final)
     stats = dict(zip(integrators.COUNTS, (int(c) for c in counts)))
     return SimulationResult(
         inputs=inputs, method=method, t=t_eval[reached], x=x, u=u, multiplier=multiplier,
         t_missed=t_eval[~reached], t_final=float(t_final), x_final=x_final, u_final=u_final,
         multiplier_final=multiplier_final, status_code=int(status), wall_s=wall,
-        length_error_max=float(worst_length), initial_info=initial_info, **stats)
+        length_error_max=float(worst[0]), n_used=int(n_used), tail_max=float(worst[1]),
+        initial_info=initial_info, **stats)

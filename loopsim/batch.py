@@ -21,45 +21,46 @@ _PARALLEL_JIT = dict(JIT, parallel=True)
 
 
 @numba.njit(**JIT)
-def run_lane(lane, lanes, method, constants, parameters, x0, t_end, options, order, y_final,
-             t_final, status, counts, worst_length):
+def run_lane(lane, lanes, method, constants, parameters, x0, t0, t_end, options, order, y_final,
+             t_final, status, counts, worst):
     """Integrate the cases order[lane], order[lane + lanes], ...; case b writes only row b."""
     no_output_times = np.empty(0)
     no_output_rows = np.empty((0, x0.shape[1]))  # read-only: no output times, nothing written
     for position in range(lane, order.shape[0], lanes):
         b = order[position]
         problem = for_case(constants, parameters[b])
-        result = integrate(method, problem, x0[b], 0.0, t_end[b], no_output_times, options,
+        result = integrate(method, problem, x0[b], t0[b], t_end[b], no_output_times, options,
                            no_output_rows)
         status[b] = result[0]
         t_final[b] = result[1]
         y_final[b] = result[2]
         counts[b] = result[3]
-        worst_length[b] = result[4]
+        worst[b] = result[4][:2]
 
 
 @numba.njit(**_PARALLEL_JIT)
-def parallel_cases(method, constants, parameters, x0, t_end, options, order, lanes, y_final,
-                   t_final, status, counts, worst_length):
+def parallel_cases(method, constants, parameters, x0, t0, t_end, options, order, lanes, y_final,
+                   t_final, status, counts, worst):
     """One lane per thread (``numba.prange``), each running :func:`run_lane`."""
     for lane in numba.prange(lanes):
-        run_lane(lane, lanes, method, constants, parameters, x0, t_end, options, order, y_final,
-                 t_final, status, counts, worst_length)
+        run_lane(lane, lanes, method, constants, parameters, x0, t0, t_end, options, order,
+                 y_final, t_final, status, counts, worst)
 
 
-def integrate_cases(method, constants, parameters, x0, t_end, options, cost=None, lanes=None):
+def integrate_cases(method, constants, parameters, x0, t_end, options, cost=None, lanes=None,
+                    t0=0.0):
     """Integrate B cases of one model and truncation in parallel.
 
     ``method``: an ``integrators.METHODS`` value; ``constants``: what all cases
     share (``models.<model>.constants(problem)``; for the loop, its operators);
     ``parameters`` (B, P): each case's model parameters (``models.for_case``;
     for the loop, g0 and w); x0 (B, ny)
-    the initial states; t_end a scalar or length-B array; ``options`` the
-    driver options (``integrators.step_options``).
+    the initial states at times t0; t0 and t_end scalars or length-B arrays;
+    ``options`` the driver options (``integrators.step_options``).
 
-    Returns (y_final, t_final, status, counts, worst_length): counts (B, 5) in
-    the order of ``integrators.COUNTS``; worst_length the largest
-    relative length error met along each trajectory.  ``cost``: an estimate
+    Returns (y_final, t_final, status, counts, worst): counts (B, 5) in the order
+    of ``integrators.COUNTS``; worst (B, 2) the largest relative length error and
+    spectral tail met along each trajectory (``integrators.integrate``).  ``cost``: an estimate
     of each case's cost (any monotone proxy; default: all equal) used to deal
     cases onto ``lanes`` (default: the Numba thread count).
     """
@@ -68,11 +69,12 @@ def integrate_cases(method, constants, parameters, x0, t_end, options, cost=None
     t_final = np.zeros(cases)
     status = np.zeros(cases, dtype=np.int64)
     counts = np.zeros((cases, len(COUNTS)), dtype=np.int64)
-    worst_length = np.zeros(cases)
+    worst = np.zeros((cases, 2))
     as_array = lambda v: np.ascontiguousarray(np.broadcast_to(np.asarray(v, float), (cases,)))
     order = np.arange(cases) if cost is None else np.argsort(-np.asarray(cost, float), kind="stable")
     lanes = numba.get_num_threads() if lanes is None else int(lanes)
     parameters = np.ascontiguousarray(np.asarray(parameters, dtype=float).reshape(cases, -1))
-    parallel_cases(method, constants, parameters, np.ascontiguousarray(x0), as_array(t_end),
-                     options, order, lanes, y_final, t_final, status, counts, worst_length)
-    return y_final, t_final, status, counts, worst_length
+    parallel_cases(method, constants, parameters, np.ascontiguousarray(x0), as_array(t0),
+                   as_array(t_end), options, order, lanes, y_final, t_final, status, counts,
+                   worst)
+    return y_final, t_final, status, counts, worst

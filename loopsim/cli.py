@@ -6,12 +6,13 @@ exit status 2; a run that fails numerically exits 1 after printing its summary.
 import argparse
 import json
 import math
+import os
 import sys
 
 from ._version import __version__
 from .config import (
-    RESOLVED_LENGTH_ERROR, RESOLVED_TAIL, DEFAULT_ATOL, DEFAULT_N, DEFAULT_PERTURBATION, DEFAULT_RTOL, DEFAULT_SEED,
-    DEFAULT_T_END, DEFAULT_W,
+    DEFAULT_ATOL, DEFAULT_N, DEFAULT_N_MAX, DEFAULT_PERTURBATION, DEFAULT_RTOL, DEFAULT_SEED,
+    DEFAULT_T_END, DEFAULT_TAIL_TOL, DEFAULT_W, RESOLVED_LENGTH_ERROR, RESOLVED_TAIL,
 )
 
 from .integrators import METHODS  # noqa: E402 - the names only; no kernel is compiled here
@@ -57,9 +58,25 @@ def _add_integration_options(parser):
     parser.add_argument("--perturbation", type=_real, default=DEFAULT_PERTURBATION, metavar="EPS",
                         help="RMS size of the seeded initial perturbation (0: exact circle; "
                         f"default {DEFAULT_PERTURBATION:g}, or 0 with --initial)")
-    parser.add_argument("--method", default="rkf45", choices=sorted(METHODS),
-                        help="time integrator: rkf45 (explicit, the paper's) or radau5 "
-                        "(implicit, for stiff stable and in-plane loops)")
+    parser.add_argument("--method", default="rkf45", choices=sorted(METHODS) + ["auto"],
+                        help="time integrator: rkf45 (explicit, the paper's), radau5 "
+                        "(implicit: stiff stable and in-plane loops, any n >= 8) or auto "
+                        "(chosen per case; recorded in the column method)")
+    parser.add_argument("--n-max", type=int, default=DEFAULT_N_MAX,
+                        help="with --n auto: the highest truncation order a case may reach")
+    parser.add_argument("--tail-tol", type=_real, default=DEFAULT_TAIL_TOL,
+                        help="with --n auto: raise n when the spectral tail (RMS relative "
+                        "amplitude of the top two modes) passes this")
+
+
+def _order(text):
+    """A truncation order (argparse type): an integer, or 'auto'."""
+    if text == "auto":
+        return text
+    try:
+        return int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not an integer or 'auto': {text!r}") from None
 
 
 def _build_parser():
@@ -89,9 +106,10 @@ def _build_parser():
     run.add_argument("--theta0", type=_real, metavar="DEG",
                      help="initial tilt of the loop's plane to the horizontal, in [0, 90] degrees "
                      "(not with --initial: the tilt is measured)")
-    run.add_argument("--n", type=int, default=None,
+    run.add_argument("--n", type=_order, default=None,
                      help=f"Fourier truncation order (>= 1; default {DEFAULT_N}, or the stored "
-                     "order of --initial results)")
+                     "order of --initial results), or auto: start there and raise n during "
+                     "the run whenever the spectral tail passes --tail-tol")
     run.add_argument("--initial", metavar="FILE|DIR",
                      help="start from a shape: a CSV/Parquet point file (columns x, y, z, in "
                      "order along the closed curve) or results (run --out file, sweep dir)")
@@ -109,14 +127,20 @@ def _build_parser():
     sweep = commands.add_parser(
         "sweep", help="run (or resume) an ensemble over (g0, theta0, n, seed) into Parquet",
         description="Integrate many loops in parallel and write one row per case into "
-        "chunk files in DIR. Re-running the same command resumes; results are read with "
-        "loopsim.read_results(DIR).",
+        "chunk files in DIR, a Parquet dataset (pandas.read_parquet(DIR); checked: "
+        "loopsim.read_results(DIR)). Re-running the same command resumes (also with another "
+        "--chunk-size). Exit status: 0 every case ok; 1 some case failed (its row says why; "
+        "see --rerun-failed); 2 bad input; 130 / 143 stopped by SIGINT / SIGTERM (finished "
+        "cases kept: re-run to resume).",
         formatter_class=_HelpFormatter,
     )
     grid = sweep.add_argument_group("cases (a grid, or --cases FILE)")
     grid.add_argument("--g0", metavar="START:STOP:NUM|v1,v2,...", help="g0 values")
     grid.add_argument("--theta0", metavar="START:STOP:NUM|v1,v2,...", help="theta0 values (deg)")
-    grid.add_argument("--n", default=str(DEFAULT_N), metavar="N[,N...]", help="truncation orders")
+    grid.add_argument("--n", default=str(DEFAULT_N), metavar="N[,N...]|auto",
+                      help="truncation orders, or auto: every case starts at n = "
+                      f"{DEFAULT_N} and climbs (up to --n-max) whenever its spectral tail passes "
+                      "--tail-tol")
     grid.add_argument("--seeds", type=int, default=1, metavar="K", help="seeds 0..K-1 per point")
     grid.add_argument("--cases", metavar="FILE", help="CSV/Parquet with columns g0, theta0_deg "
                       "[, n, seed, perturbation, initial, initial_case_id] instead of a grid "
@@ -131,10 +155,28 @@ def _build_parser():
     sweep.add_argument("--snapshots", type=int, default=101, metavar="K",
                        help="snapshots per selected trajectory")
     sweep.add_argument("--threads", type=int, default=None, help="threads (default: all cores)")
-    sweep.add_argument("--chunk-size", type=int, default=32, help="cases per chunk file")
-    sweep.add_argument("--out", required=True, metavar="DIR", help="sweep directory")
+    sweep.add_argument("--chunk-size", type=int, default=32,
+                       help="cases per chunk file (and per Dask task); may change on resume")
+    sweep.add_argument("--out", metavar="DIR", help="sweep directory (required)")
     sweep.add_argument("--figure", metavar="PNG", help="also draw the phase diagram")
     sweep.add_argument("--quiet", action="store_true", help="no progress line, only a summary")
+    sweep.add_argument("--progress-every", type=_real, default=30.0, metavar="SECONDS",
+                       help="progress line interval when stderr is not a terminal (a log file)")
+    where = sweep.add_argument_group("where the cases run (default: this machine's threads)")
+    where.add_argument("--scheduler", metavar="ADDRESS",
+                       help="send chunks as tasks to the Dask scheduler at ADDRESS "
+                       "(tcp://host:8786); finished chunks come back and are written here")
+    where.add_argument("--dask", action="store_true",
+                       help="start a Dask LocalCluster here and send chunks to it")
+    where.add_argument("--workers", type=int, default=None,
+                       help="with --dask: worker processes (default: cores / --threads)")
+    where.add_argument("--shard", metavar="I/N",
+                       help="only chunks k with k %% N == I (0 <= I < N), for job arrays: "
+                       "N jobs with the same command and I = the array index fill DIR together")
+    where.add_argument("--rerun-failed", metavar="DIR",
+                       help="rerun only DIR's failed cases with this command's --method, --rtol "
+                       "and --atol; rows replaced, earlier rows kept in DIR/_reruns/ "
+                       "(resumable: re-run the same command)")
 
     stability = commands.add_parser(
         "stability", help="critical q of the translating circle (full linearisation)",
@@ -169,6 +211,42 @@ def _build_parser():
                              help="the table of the paper's operator for n = 1..--n-max instead")
     paper_group.add_argument("--n-max", type=int, default=None,
                              help="largest truncation order of the --paper table (default 60)")
+
+    branch = commands.add_parser(
+        "branch", help="steady in-plane shapes from the circle's bifurcation, and their stability",
+        description="Relative equilibria (shapes that translate without changing) of the "
+        "loop in its plane, continued in q = g0 sin(theta0)/3 from the circle's in-plane "
+        "threshold, with their aspect ratio and leading in-plane and out-of-plane "
+        "eigenvalues (loopsim/stability/branch.py, docs/stability.md).",
+        formatter_class=_HelpFormatter,
+    )
+    branch.add_argument("--n", type=int, default=12, help="Fourier truncation order (>= 4)")
+    branch.add_argument("--q-max", type=_real, default=25.0, metavar="Q",
+                        help="continue up to this q (> the in-plane threshold 8.9001)")
+    branch.add_argument("--json", action="store_true", help="print one JSON object")
+
+    figures = commands.add_parser(
+        "figures", help="draw the paper's figures (or corrected counterparts) from Parquet",
+        description="Draw the paper's figures from stored results into DIR as PNG: Fig. 3 "
+        "(stability, computed), from SWEEP_DIR Figs. 4, 5, 7, 8; from more sweep "
+        "directories Fig. 9 (a grid at another n), seed distributions (several seeds of one "
+        "point) or a reference overlay (any other); from run files (loopsim run --out) "
+        "Fig. 6 and the tension colouring (loopsim/figures.py).",
+        formatter_class=_HelpFormatter,
+    )
+    figures.add_argument("sweep_dir", metavar="SWEEP_DIR", help="the main sweep directory")
+    figures.add_argument("paths", nargs="*", metavar="PATH",
+                         help="more sweep directories and run files (RUN.parquet)")
+    figures.add_argument("--out", required=True, metavar="DIR", help="output directory (made if absent)")
+    figures.add_argument("--only", metavar="NAME[,NAME...]",
+                         help="draw only these: stability, gallery, phase, q_tilt, aspect, "
+                         "phase_n, seeds, evolution, tension")
+    figures.add_argument("--gallery-theta0", type=_real, default=30.0, metavar="DEG",
+                         help="initial tilt of the Fig. 4 gallery (nearest in the sweep)")
+    figures.add_argument("--branch-n", type=int, default=12, metavar="N",
+                         help="truncation of the steady branch drawn in Fig. 8")
+    figures.add_argument("--no-branch", action="store_true", help="Fig. 8 without the steady branch")
+    figures.add_argument("--dpi", type=int, default=110, help="resolution of the PNG files")
     return parser
 
 
@@ -188,9 +266,10 @@ def _load_initial_for_run(args):
     if args.theta0 is not None:
         raise ValueError("give --theta0 or --initial, not both (the tilt of an --initial shape "
                          "is measured from it)")
-    if args.n is not None and args.n < 1:
+    if args.n not in (None, "auto") and args.n < 1:
         raise ValueError(f"n must be an integer >= 1, got {args.n}")
-    x, info = shapes.load_initial(args.initial, args.n, args.case_id)
+    x, info = shapes.load_initial(args.initial, None if args.n == "auto" else args.n,
+                                  args.case_id)
     g0 = args.g0 if args.g0 is not None else info.get("g0")
     if g0 is None:
         raise ValueError("--g0 is required (only results carry a g0 to continue with)")
@@ -220,7 +299,8 @@ def _cmd_run(args):
     result = api.simulate(
         g0, args.theta0, n=args.n, t_span=(0.0, args.t_end), snapshots=args.snapshots,
         rtol=args.rtol, atol=args.atol, w=args.w, perturbation=args.perturbation,
-        seed=args.seed, method=args.method, initial=start,
+        seed=args.seed, method=args.method, initial=start, n_max=args.n_max,
+        tail_tol=args.tail_tol,
     )
     summary = result.summary()
     if info is not None:
@@ -228,11 +308,11 @@ def _cmd_run(args):
         result.initial_info = info
         for warning in info["warnings"]:
             print(f"loopsim: warning: {warning}", file=sys.stderr)
-    if not ensemble.Thresholds().resolved(result.length_error_max, summary["spectral_tail"]):
-        print(f"loopsim: warning: not resolved at n = {summary['n']} (length error up to "
-              f"{result.length_error_max:.2g}, limit {RESOLVED_LENGTH_ERROR:g}; terminal spectral "
-              f"tail {summary['spectral_tail']:.2g}, limit {RESOLVED_TAIL:g}): the terminal tilt "
-              "and shape are not converged; increase --n", file=sys.stderr)
+    if not ensemble.Thresholds().resolved(result.length_error_max, result.tail_max):
+        print(f"loopsim: warning: not resolved at n = {summary['n_used']} (length error up to "
+              f"{result.length_error_max:.2g}, limit {RESOLVED_LENGTH_ERROR:g}; spectral tail up "
+              f"to {result.tail_max:.2g}, limit {RESOLVED_TAIL:g}): the terminal tilt and shape "
+              "are not converged; increase --n or use --n auto", file=sys.stderr)
     if args.out and info is None:
         io.write_trajectory(result, args.out, command_line=sys.argv)
     elif args.out:  # the initial shape's diagnostics (scale, source) as metadata "initial"
@@ -248,6 +328,68 @@ def _cmd_run(args):
     return 0 if result.success else EXIT_FAILED_RUN
 
 
+RERUN_OPTIONS = ("method", "rtol", "atol")  # what --rerun-failed takes from the command line
+
+
+def _parse_shard(text):
+    """'I/N' -> (I, N) with 0 <= I < N, or a one-line error."""
+    try:
+        index, count = (int(part) for part in text.split("/"))
+        if not 0 <= index < count:
+            raise ValueError
+    except ValueError:
+        raise ValueError(f"--shard must be I/N with integers 0 <= I < N, got {text!r}") from None
+    return index, count
+
+
+def _sweep_config(args, ensemble):
+    if args.cases:
+        if args.g0 or args.theta0:
+            raise ValueError("give either --cases or --g0/--theta0, not both")
+        orders = [DEFAULT_N] if args.n == "auto" else ensemble.parse_values(args.n, "--n",
+                                                                             integer=True)
+        cases = ensemble.read_cases_file(args.cases, args.perturbation, orders[0])
+    else:
+        if not (args.g0 and args.theta0):
+            raise ValueError("a sweep needs --g0 and --theta0 (or --cases FILE)")
+        if args.seeds < 1:
+            raise ValueError(f"--seeds must be >= 1, got {args.seeds}")
+        cases = ensemble.grid_cases(
+            ensemble.parse_values(args.g0, "--g0"), ensemble.parse_values(args.theta0, "--theta0"),
+            [DEFAULT_N] if args.n == "auto" else ensemble.parse_values(args.n, "--n", integer=True),
+            args.seeds, args.perturbation)
+    return ensemble.SweepConfig(cases=cases, t_end=args.t_end, rtol=args.rtol, atol=args.atol,
+                                w=args.w, method=args.method, chunk_size=args.chunk_size,
+                                early_stop=not args.no_early_stop,
+                                snapshots_for=ensemble.parse_values(
+                                    args.snapshots_for, "--snapshots-for", integer=True)
+                                if args.snapshots_for else [],
+                                snapshot_count=args.snapshots, n_auto=args.n == "auto",
+                                n_max=args.n_max, tail_tol=args.tail_tol)
+
+
+def _check_rerun_options(args):
+    """With --rerun-failed the cases and settings come from DIR: refuse the options that
+    would be ignored (given with a value other than their default)."""
+    parser = _build_parser()
+    defaults = vars(parser.parse_args(["sweep"]))
+    ignored = [key for key in ("g0", "theta0", "cases", "n", "seeds", "t_end", "w", "perturbation",
+                               "no_early_stop", "snapshots_for", "snapshots", "chunk_size",
+                               "shard", "out")
+               if getattr(args, key) != defaults[key]]
+    if ignored:
+        raise ValueError(f"--{ignored[0].replace('_', '-')} does not apply with --rerun-failed "
+                         f"(the cases and settings come from the sweep; only "
+                         f"{', '.join('--' + k for k in RERUN_OPTIONS)} change)")
+
+
+def _is_program():
+    """Whether this process is the ``loopsim`` command (not a caller of :func:`main`)."""
+    program = os.path.abspath(sys.argv[0]) if sys.argv and sys.argv[0] else ""
+    return (os.path.basename(program) == "loopsim"
+            or program.endswith(os.path.join("loopsim", "__main__.py")))
+
+
 def _cmd_sweep(args):
     import numba
 
@@ -258,30 +400,47 @@ def _cmd_sweep(args):
     if args.threads is not None and not 1 <= args.threads <= numba.config.NUMBA_NUM_THREADS:
         raise ValueError(f"--threads must be in 1..{numba.config.NUMBA_NUM_THREADS} (the "
                          f"cores Numba may use), got {args.threads}")
-    if args.cases:
-        if args.g0 or args.theta0:
-            raise ValueError("give either --cases or --g0/--theta0, not both")
-        orders = ensemble.parse_values(args.n, "--n", integer=True)
-        cases = ensemble.read_cases_file(args.cases, args.perturbation, orders[0])
-    else:
-        if not (args.g0 and args.theta0):
-            raise ValueError("a sweep needs --g0 and --theta0 (or --cases FILE)")
-        if args.seeds < 1:
-            raise ValueError(f"--seeds must be >= 1, got {args.seeds}")
-        cases = ensemble.grid_cases(
-            ensemble.parse_values(args.g0, "--g0"), ensemble.parse_values(args.theta0, "--theta0"),
-            ensemble.parse_values(args.n, "--n", integer=True), args.seeds, args.perturbation)
-    config = ensemble.SweepConfig(cases=cases, t_end=args.t_end, rtol=args.rtol, atol=args.atol,
-                                  w=args.w, method=args.method, chunk_size=args.chunk_size,
-                                  early_stop=not args.no_early_stop,
-                                  snapshots_for=ensemble.parse_values(
-                                      args.snapshots_for, "--snapshots-for", integer=True)
-                                  if args.snapshots_for else [],
-                                  snapshot_count=args.snapshots)
-    frame = ensemble.run_sweep(config, args.out, threads=args.threads, quiet=args.quiet,
-                               command_line=sys.argv)
+    if args.workers is not None and (args.workers < 1 or not args.dask):
+        raise ValueError(f"--workers needs --dask and must be >= 1, got {args.workers}")
+    if args.scheduler is not None and args.dask:
+        raise ValueError("give --scheduler ADDRESS or --dask, not both")
+    if not args.progress_every > 0:
+        raise ValueError(f"--progress-every must be > 0, got {args.progress_every:g}")
+    backend = dict(threads=args.threads, quiet=args.quiet, command_line=sys.argv,
+                   scheduler=args.scheduler, local_cluster=args.dask, workers=args.workers,
+                   progress_interval=args.progress_every)
+    try:
+        if args.rerun_failed is not None:
+            _check_rerun_options(args)
+            out = args.rerun_failed
+            settings = {k: getattr(args, k) for k in RERUN_OPTIONS}
+            frame, reran = ensemble.rerun_failed(out, **settings, **backend)
+            print(f"reran {reran} failed case(s) with " + ", ".join(
+                f"{k} {getattr(args, k)}" for k in RERUN_OPTIONS))
+            config = ensemble.SweepConfig(cases=[])
+        else:
+            if args.out is None:
+                raise ValueError("a sweep needs --out DIR (or --rerun-failed DIR)")
+            out = args.out
+            config = _sweep_config(args, ensemble)
+            frame = ensemble.run_sweep(config, out, shard=None if args.shard is None
+                                       else _parse_shard(args.shard), **backend)
+    except KeyboardInterrupt as stopped:  # ensemble.SweepInterrupted, or a Ctrl-C before it
+        signum = getattr(stopped, "signum", 2)
+        name = "SIGINT" if signum == 2 else "SIGTERM"
+        done = (f": {stopped.done} of {stopped.total} cases done and kept in "
+                f"{stopped.out}" if hasattr(stopped, "done") else "")
+        print(f"loopsim: interrupted by {name}{done}; re-run the same command to resume",
+              file=sys.stderr)
+        status = getattr(stopped, "exit_status", 130)
+        if _is_program():  # a kernel may still run in a thread: no seconds-long teardown
+            sys.stdout.flush()
+            sys.stderr.flush()
+            os._exit(status)
+        return status
     counts = frame["regime"].value_counts().to_dict()
-    print(f"{len(frame)} cases in {args.out}: " + ", ".join(f"{k} {v}" for k, v in sorted(counts.items())))
+    print(f"{len(frame)} cases in {out}: "
+          + ", ".join(f"{k} {v}" for k, v in sorted(counts.items())))
     unresolved = frame[~frame["resolved"]]
     if len(unresolved):
         print(f"{len(unresolved)} of {len(frame)} cases NOT resolved at their n (transient length "
@@ -294,6 +453,12 @@ def _cmd_sweep(args):
         _use_agg()
         plots.save(plots.phase_diagram(frame), args.figure)
         print(f"phase diagram: {args.figure}")
+    failed = int((frame["status"] != "ok").sum())
+    if failed:
+        print(f"{failed} of {len(frame)} cases failed (column 'status'); exit status "
+              f"{EXIT_FAILED_RUN}; rerun them with: loopsim sweep --rerun-failed {out} "
+              "--method radau5 (or another --rtol)", file=sys.stderr)
+        return EXIT_FAILED_RUN
     return 0
 
 
@@ -404,6 +569,49 @@ def _cmd_stability(args):
     return 0
 
 
+def _cmd_branch(args):
+    from .stability import branch
+
+    if args.n < 4:
+        raise ValueError(f"--n must be >= 4, got {args.n}")
+    if not args.q_max > 9.0:
+        raise ValueError(f"--q-max must be > 9 (the branch starts at q = 8.9001), got {args.q_max}")
+    out = branch.branch_summary(args.n, args.q_max, q_min=0.0)
+    if args.json:
+        print(json.dumps(out))
+        return 0
+    loss = out["q_loss_out_of_plane"]
+    print(f"# steady in-plane shapes, n = {out['n']}, w = {out['w']:g}: bifurcation off the circle "
+          f"at q = {out['q_bifurcation']:.9f} (circle's in-plane threshold {out['q_circle']:.9f})")
+    print(f"# q_loss_out_of_plane = {'none below --q-max' if loss is None else f'{loss:.6f}'}; "
+          "side +1: the half leaving towards q > q_c, -1: the other half, 0: the circle")
+    print(f"{'side':>4} {'q':>10} {'aspect':>9} {'in-plane':>11} {'out-of-plane':>13}  stable (in, out)")
+    for row in out["branch"]:
+        print(f"{row['side']:>4} {row['q']:>10.5f} {row['aspect_ratio']:>9.5f} "
+              f"{row['leading_in_plane_real']:>11.5f} {row['leading_out_of_plane_real']:>13.5f}  "
+              f"{row['stable_in_plane']!s:>5} {row['stable_out_of_plane']!s:>5}")
+    return 0
+
+
+def _cmd_figures(args):
+    import os
+
+    _use_agg()
+    from . import figures
+
+    only = [v.strip() for v in args.only.split(",") if v.strip()] if args.only else None
+    if not os.path.isdir(args.sweep_dir):
+        raise ValueError(f"no sweep directory at {args.sweep_dir!r}")
+    if args.dpi < 20:
+        raise ValueError(f"--dpi must be >= 20, got {args.dpi}")
+    os.makedirs(args.out, exist_ok=True)
+    written = figures.write_figures(args.sweep_dir, args.paths, args.out, only=only,
+                                    gallery_theta0=args.gallery_theta0, branch_n=args.branch_n,
+                                    branch=not args.no_branch, dpi=args.dpi)
+    print(f"{len(written)} figures in {args.out}")
+    return 0
+
+
 def _use_agg():
     """Figures from the command line are files: the non-interactive Agg backend."""
     import matplotlib
@@ -414,7 +622,8 @@ def _use_agg():
 def main(argv=None):
     parser = _build_parser()
     args = parser.parse_args(argv)
-    handlers = {"run": _cmd_run, "sweep": _cmd_sweep, "stability": _cmd_stability}
+    handlers = {"run": _cmd_run, "sweep": _cmd_sweep, "stability": _cmd_stability,
+                "branch": _cmd_branch, "figures": _cmd_figures}
     try:
         return handlers[args.command](args)
     except (ValueError, OSError) as exc:

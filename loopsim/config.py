@@ -37,13 +37,21 @@ DEFAULT_LENGTH_TOL = 0.25
 DEFAULT_STEADY_INTERVAL = 0.5
 DEFAULT_STEADY_TOL = 1e-6
 #: A run is *resolved* at its truncation n when its worst transient relative length
-#: error stays at or below RESOLVED_LENGTH_ERROR and its terminal spectral tail
-#: (``diagnostics.spectral_tail``) at or below RESOLVED_TAIL.  Evidence
-#: (scripts/resolution_study.py, n = 6 against n = 16 from the same start curve, 14
-#: cases g0 = 30..350, θ0 = 30..85°; table in the README): the 2 cases whose terminal
-#: tilt and aspect ratio agree (to 1e-4° and 3e-7) had length errors ≤ 1.5e-7 and tails
-#: ≤ 1.1e-8; the 12 that differ (by 0.02 to 3.8 in aspect ratio, up to 62° in tilt) had
-#: length errors ≥ 1.5e-4, or (g0 = 30, θ0 = 85°, in-plane) a tail of 1.2e-3.  The tail
-#: alone is no guide: wrong 3D runs at n = 6 end as near-circles with tails of 1e-13.
+#: error stays at or below RESOLVED_LENGTH_ERROR and its spectral tail (the RMS share of
+#: the top two modes, ``diagnostics.spectral_tail``), once it has started to grow along
+#: the run, at or below RESOLVED_TAIL (the decay of a seeded start's own top modes does
+#: not count: ``integrators.control.monitor``).  ``n="auto"`` raises n whenever the tail
+#: passes DEFAULT_TAIL_TOL, the same value.  Evidence (scripts/resolution_study.py and
+#: scripts/auto_study.py, fixed runs from one and the same start curve; tables in the
+#: README): at n = 6 every 3D case has length errors ≥ 1.5e-4 and tails ≥ 1e-3 and is
+#: tens of degrees off; g0 = 150, θ0 = 45° at n = 16 has a length error of 1.7e-7 but
+#: a tail of 3.2e-5 and a terminal tilt 5.1° off the n = 24 run (tail 2.1e-7); at a
+#: tail tolerance of 1e-4 the auto runs' tilts are off by up to 12°, at 1e-5 by at most
+#: 0.22° (aspect ratio 3.6e-3) on the 3D and in-plane cases.
 RESOLVED_LENGTH_ERROR = 1e-5
-RESOLVED_TAIL = 1e-3
+RESOLVED_TAIL = 1e-5
+#: Automatic truncation (``n="auto"``, ``loopsim.refinement``): the orders a case may
+#: climb, the default top order, and the spectral-tail tolerance that sends a case up.
+AUTO_ORDERS = (6, 8, 12, 16, 20, 24, 32, 40, 48, 64)
+DEFAULT_N_MAX = 32
+DEFAULT_TAIL_TOL = RESOLVED_TAIL

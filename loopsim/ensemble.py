@@ -1,36 +1,42 @@
-"""Ensemble sweeps: cases -> chunks -> Parquet files in a directory, resumable.
+"""Ensemble sweeps: cases -> pieces -> Parquet files in a directory, resumable.
 
-A sweep directory holds ``sweep.json`` (the configuration, written first) and
-one ``chunk-KKKKK.parquet`` per finished chunk, each written under a
-temporary name and renamed into place.  A chunk is the unit of work: chunk k
-holds the cases with ``case_id % n_chunks == k`` (interleaved, so every
-chunk mixes cheap and costly corners of the grid).  Re-running the same sweep
-skips finished chunks; a different configuration in the same directory is
-refused.  No numerics here: integration is ``batch``, start shapes
-``shapes``, summaries ``api``, tables ``io``.
+A sweep directory is a Parquet dataset (``pandas.read_parquet(DIR)`` returns the
+rows): ``_sweep.json`` (the configuration and its fingerprint, written once,
+first), one ``chunk-SSSSSSS-EEEEEEE.parquet`` per finished piece at the top,
+snapshots in ``_snapshots/``.  Cases are laid out in a fixed order of positions
+(:func:`case_order`, a golden-ratio stride, so neighbours differ); chunk k is
+positions [k c, (k + 1) c) for chunk size c, and a file holds the positions
+[S, E) of a finished piece of a chunk, written under a temporary name and
+renamed into place.  A resume computes the positions no file holds, so a
+changed chunk size, a piece cut short by a signal and job-array shards all
+fit.  Pieces run on this machine's Numba threads or as Dask tasks.  No numerics
+here: integration is ``batch``, start shapes ``shapes``, summaries ``api``,
+tables ``io``.
 """
+import contextlib
 import dataclasses
 import itertools
 import json
 import math
 import os
+import signal
 import sys
+import threading
 import time
 
 import numpy as np
 import pandas as pd
 import pyarrow as pa
 
-from . import api, batch, diagnostics, integrators, io, models, shapes, validation
+from . import (
+    api, diagnostics, integrators, io, models, refinement, shapes, spectral, validation,
+)
 from .config import (
-    DEFAULT_ATOL, DEFAULT_LENGTH_TOL, DEFAULT_MAX_STEPS, DEFAULT_PERTURBATION, DEFAULT_RTOL,
-    DEFAULT_STEADY_INTERVAL, DEFAULT_STEADY_TOL, DEFAULT_T_END, DEFAULT_W, RESOLVED_LENGTH_ERROR,
-    RESOLVED_TAIL,
+    DEFAULT_ATOL, DEFAULT_LENGTH_TOL, DEFAULT_MAX_STEPS, DEFAULT_N_MAX, DEFAULT_PERTURBATION,
+    DEFAULT_RTOL, DEFAULT_STEADY_INTERVAL, DEFAULT_STEADY_TOL, DEFAULT_T_END, DEFAULT_TAIL_TOL,
+    DEFAULT_W, RESOLVED_LENGTH_ERROR, RESOLVED_TAIL,
 )
 
-CONFIG_FILE = "sweep.json"
-CHUNK_PATTERN = io.CHUNK_PATTERN
-SNAPSHOT_PATTERN = io.SNAPSHOT_PATTERN
 REGIMES = ("stable", "in-plane", "3d", "failed")
 
 
@@ -42,8 +48,8 @@ class Thresholds:
     tilt_change_deg: |θ_final − θ0| above which the tilt has changed.
     shape_change: |aspect ratio_final − aspect ratio_initial| above which the shape has.
     resolved_length_error, resolved_tail: a case is resolved at its n when its worst
-    transient relative length error and its terminal spectral tail stay at or below
-    these (``config.RESOLVED_LENGTH_ERROR``, ``config.RESOLVED_TAIL``).
+    transient relative length error and its largest spectral tail along the run stay at
+    or below these (``config.RESOLVED_LENGTH_ERROR``, ``config.RESOLVED_TAIL``).
     """
 
     tilt_change_deg: float = 1.0
@@ -51,10 +57,10 @@ class Thresholds:
     resolved_length_error: float = RESOLVED_LENGTH_ERROR
     resolved_tail: float = RESOLVED_TAIL
 
-    def resolved(self, length_error_max, spectral_tail):
+    def resolved(self, length_error_max, tail_max):
         """Whether a case with these diagnostics is resolved at its n."""
         return bool(length_error_max <= self.resolved_length_error
-                    and spectral_tail <= self.resolved_tail)
+                    and tail_max <= self.resolved_tail)
 
 
 def classify(theta0_deg, theta_final_deg, aspect_initial, aspect_final, ok, thresholds=Thresholds()):
@@ -75,9 +81,15 @@ FIELD_NOTES = {
     "regime": "stable | in-plane | 3d | failed (see thresholds)",
     "stop_reason": "t_end | steady (terminal state reached early) | the failure",
     "length_error_max": "largest |relative length error| along the trajectory (transient)",
-    "resolved": "length_error_max <= thresholds.resolved_length_error and spectral_tail <= "
-                "thresholds.resolved_tail: n resolves the case (False: raise n; its terminal "
-                "outcome is not converged)",
+    "resolved": "length_error_max <= thresholds.resolved_length_error and tail_max <= "
+                "thresholds.resolved_tail: n_used resolves the case (False: raise n or use "
+                "--n auto; its terminal outcome is not converged)",
+    "n": "the truncation order the case started at (with --n auto: the ladder's first)",
+    "n_used": "the truncation order the case ended at (with --n auto: the highest reached)",
+    "tail_max": "largest spectral tail (RMS relative amplitude of the top two modes) "
+                "along the run at n_used (with --n auto, lower orders were left when their "
+                "tail passed tail_tol)",
+    "method": "the integrator that ran the case (--method auto chooses per case)",
 }
 
 
@@ -104,9 +116,9 @@ def parse_values(text, name, integer=False):
 
 @dataclasses.dataclass
 class SweepConfig:
-    """Everything that determines a sweep's results (stored in sweep.json)."""
+    """Everything that determines a sweep's results (stored in _sweep.json)."""
 
-    cases: list  # of dicts: g0, theta0_deg, n, seed, perturbation
+    cases: list  # of dicts: g0, theta0_deg, n (the start with n_auto), seed, perturbation
     t_end: float = DEFAULT_T_END
     rtol: float = DEFAULT_RTOL
     atol: float = DEFAULT_ATOL
@@ -121,6 +133,9 @@ class SweepConfig:
     steady_interval: float = DEFAULT_STEADY_INTERVAL
     steady_tol: float = DEFAULT_STEADY_TOL
     thresholds: Thresholds = Thresholds()
+    n_auto: bool = False  # raise n during each run (loopsim.refinement)
+    n_max: int = DEFAULT_N_MAX
+    tail_tol: float = DEFAULT_TAIL_TOL
 
     def step_options(self):
         return integrators.step_options(
@@ -220,14 +235,12 @@ def validate(config):
         if not 0 <= case_id < len(config.cases):
             raise ValueError(f"--snapshots-for names case {case_id}, but the sweep has cases "
                              f"0..{len(config.cases) - 1}")
-    validation.check_choice("method", config.method, integrators.METHODS)
+    validation.check_choice("method", config.method, refinement.METHOD_CHOICES)
+    validation.check_integer("n_max", config.n_max, 1)
+    validation.check_real("tail_tol", config.tail_tol, low=0.0, low_open=True)
 
 
 # ---- running ---------------------------------------------------------------
-def chunk_case_ids(config, chunk):
-    return list(range(chunk, len(config.cases), config.n_chunks))
-
-
 def _start(case):
     """Keyword arguments of ``shapes.start_shape`` (and ``simulate``) for a case's start."""
     if case.get("initial"):  # a case started from a file (cases column "initial")
@@ -237,24 +250,41 @@ def _start(case):
                 seed=case["seed"])
 
 
-def _result_row(config, case_id, case, x0, x, status_code, counts, worst_length, wall_s, t_final):
-    """One row of RESULT_SCHEMA for a finished case with final coefficients x (3, 2n+1)."""
+def case_method(config, case):
+    """The integrator of a case: the sweep's, or chosen per case (``method = "auto"``)."""
+    if config.method != "auto":
+        return config.method
+    return refinement.auto_method(diagnostics.stability_parameter(case["g0"], case["theta0_deg"]),
+                                  case["n"], config.n_auto)
+
+
+def case_ladder(config, case):
+    """The truncation orders a case may use: its n, or with ``n_auto`` the ladder above it."""
     n = case["n"]
+    return refinement.orders(n, max(n, config.n_max)) if config.n_auto else (n,)
+
+
+def _result_row(config, case_id, case, x0, x, status_code, counts, worst, wall_s, t_final,
+                method):
+    """One row of RESULT_SCHEMA for a finished case with final coefficients x (3, 2 n_used + 1);
+    worst = (largest length error, largest spectral tail)."""
+    n_used = (x.shape[1] - 1) // 2
     if not np.all(np.isfinite(x)):
-        x = x0  # keep the row finite; the status says why
-    problem = models.local_sbt.make_problem(n, case["g0"], config.w)
+        x = spectral.resize(x0, n_used)  # keep the row finite; the status says why
+    problem = models.local_sbt.make_problem(n_used, case["g0"], config.w)
     u, multiplier = api.velocity_and_multiplier(problem, x)
-    inputs = dict(g0=case["g0"], theta0_deg=case["theta0_deg"], n=n, t_end=config.t_end,
+    inputs = dict(g0=case["g0"], theta0_deg=case["theta0_deg"], n=case["n"], t_end=config.t_end,
                   rtol=config.rtol, atol=config.atol, w=config.w,
                   perturbation=case["perturbation"], seed=case["seed"])
     row = api.terminal_summary(
-        inputs, x, u, multiplier, status=integrators.STATUS_NAMES[status_code], t_final=t_final,
-        wall_s=wall_s, **dict(zip(integrators.COUNTS, (int(c) for c in counts))))
+        inputs, x, u, multiplier, method=method, n_used=n_used,
+        status=integrators.STATUS_NAMES[status_code], t_final=t_final, wall_s=wall_s,
+        tail_max=float(worst[1]), **dict(zip(integrators.COUNTS, (int(c) for c in counts))))
     aspect0 = diagnostics.aspect_ratio(x0)
     row.update(
         case_id=case_id, aspect_ratio_initial=aspect0, x_final=x.ravel().tolist(),
-        length_error_max=float(worst_length), stop_reason=integrators.STOP_REASONS[status_code],
-        resolved=config.thresholds.resolved(worst_length, row["spectral_tail"]),
+        length_error_max=float(worst[0]), stop_reason=integrators.STOP_REASONS[status_code],
+        resolved=config.thresholds.resolved(worst[0], worst[1]),
         regime=classify(case["theta0_deg"], row["theta_final_deg"], aspect0, row["aspect_ratio"],
                         status_code in integrators.SUCCESS, config.thresholds),
     )
@@ -265,15 +295,19 @@ def _traced_case(config, case_id):
     """A case with snapshots: its row and trajectory come from one ``api.simulate`` run,
     so they agree exactly (its steps land on the snapshot times)."""
     case = config.cases[case_id]
+    method = case_method(config, case)
     result = api.simulate(
         case["g0"], **_start(case), t_span=(0.0, config.t_end),
         snapshots=config.snapshot_count, rtol=config.rtol, atol=config.atol, w=config.w,
-        method=config.method, max_steps=config.max_steps, length_tol=config.length_tol,
+        method=method, max_steps=config.max_steps, length_tol=config.length_tol,
         steady_tol=config.steady_tol if config.early_stop else None,
-        steady_interval=config.steady_interval)
-    row = _result_row(config, case_id, case, result.x[0], result.x_final, result.status_code,
+        steady_interval=config.steady_interval, n_max=config.n_max, tail_tol=config.tail_tol,
+        **({"n": "auto"} if config.n_auto else {}))
+    x0 = shapes.start_shape(**_start(case))[0]
+    row = _result_row(config, case_id, case, x0, result.x_final, result.status_code,
                       [getattr(result, name) for name in integrators.COUNTS],
-                      result.length_error_max, result.wall_s, result.t_final)
+                      (result.length_error_max, result.tail_max), result.wall_s,
+                      result.t_final, method)
     table = io.trajectory_table(result).replace_schema_metadata(None)
     for name in ("x", "multiplier"):  # orders differ between cases: variable-length lists
         table = table.set_column(table.schema.get_field_index(name), name,
@@ -285,36 +319,38 @@ def run_chunk(config, chunk, threads):
     """Integrate one chunk's cases.
 
     Returns (results Table in RESULT_SCHEMA, snapshots Table or None).  Cases
-    without snapshots run in the parallel batch kernel, grouped by n; their
+    without snapshots run in the parallel batch kernel (``refinement.integrate_cases``:
+    a fixed n is a ladder of one order), grouped by starting n and method; their
     ``wall_s`` is the batch's wall time x threads shared in proportion to RHS
     evaluations.
     """
     ids = chunk_case_ids(config, chunk)
     traced = sorted(set(ids) & set(config.snapshots_for))
-    by_order = {}
+    groups = {}
     for case_id in ids:
         if case_id not in traced:
-            by_order.setdefault(config.cases[case_id]["n"], []).append(case_id)
+            case = config.cases[case_id]
+            groups.setdefault((case["n"], case_method(config, case)), []).append(case_id)
     start = time.perf_counter()
     outputs = []
-    for n, members in sorted(by_order.items()):
+    for (n, method), members in sorted(groups.items()):
         cases = [config.cases[i] for i in members]
-        x0 = np.array([shapes.start_shape(**_start(c))[0].ravel() for c in cases])
-        result = batch.integrate_cases(
-            integrators.METHODS[config.method], models.local_sbt.make_operators(n),
-            [(c["g0"], config.w) for c in cases], x0, config.t_end, config.step_options(),
+        x0 = [shapes.start_shape(**_start(c))[0] for c in cases]
+        result = refinement.integrate_cases(
+            integrators.METHODS[method], [(c["g0"], config.w) for c in cases], x0,
+            config.t_end, config.step_options(), case_ladder(config, cases[0]),
+            config.tail_tol,
             cost=[diagnostics.stability_parameter(c["g0"], c["theta0_deg"]) for c in cases])
-        outputs.append((members, x0, result))
+        outputs.append((members, x0, method, result))
     wall = time.perf_counter() - start
-    total_rhs = sum(int(result[3][:, 2].sum()) for _, _, result in outputs) or 1
+    total_rhs = sum(int(result[4][:, 2].sum()) for *_, result in outputs) or 1
     rows = {}
-    for members, x0, (y_final, t_final, status, counts, worst) in outputs:
+    for members, x0, method, (x_final, _, t_final, status, counts, worst) in outputs:
         for b, case_id in enumerate(members):
-            shape = (3, x0.shape[1] // 3)
             rows[case_id] = _result_row(
-                config, case_id, config.cases[case_id], x0[b].reshape(shape),
-                y_final[b].reshape(shape), int(status[b]), counts[b], worst[b],
-                wall * threads * counts[b, 2] / total_rhs, float(t_final[b]))
+                config, case_id, config.cases[case_id], x0[b], x_final[b], int(status[b]),
+                counts[b], worst[b], wall * threads * counts[b, 2] / total_rhs,
+                float(t_final[b]), method)
     snapshots = []
     for case_id in traced:
         rows[case_id], table = _traced_case(config, case_id)
@@ -323,98 +359,481 @@ def run_chunk(config, chunk, threads):
     return table, (pa.concat_tables(snapshots) if snapshots else None)
 
 
+# ---- where the cases go: positions, chunks, pieces ----------------------------------
+case_order = io.case_order
+
+
+def canonical_chunks(config):
+    """The chunks of ``config.chunk_size`` consecutive positions (the last one shorter)."""
+    size, count = config.chunk_size, len(config.cases)
+    return [range(start, min(start + size, count)) for start in range(0, count, size)]
+
+
+def chunk_case_ids(config, chunk):
+    """Sorted case ids of a piece of work: ``chunk`` a range of positions (see
+    :func:`case_order`), or an int k, the k-th of :func:`canonical_chunks`."""
+    if not isinstance(chunk, range):
+        chunk = canonical_chunks(config)[int(chunk)]
+    order = case_order(len(config.cases))
+    return sorted(order[p] for p in chunk)
+
+
+def pending_pieces(config, covered, shard=None):
+    """Position ranges still to compute: every chunk (of shard ``(i, n)``: the chunks k
+    with k % n == i) less the positions ``covered`` (ranges of the files already there).
+    A function of the configuration, the chunk size and the files only, so identical
+    sweeps run side by side compute the same pieces and write the same file names; a
+    changed chunk size only cuts the remaining positions differently (no case is lost or
+    computed twice)."""
+    pieces = []
+    for k, chunk in enumerate(canonical_chunks(config)):
+        if shard is not None and k % shard[1] != shard[0]:
+            continue
+        start = chunk.start
+        for low, high in sorted(covered):
+            if high <= start or low >= chunk.stop:
+                continue
+            if low > start:
+                pieces.append(range(start, low))
+            start = max(start, high)
+        if start < chunk.stop:
+            pieces.append(range(start, chunk.stop))
+    return pieces
+
+
+def write_piece(out, fingerprint, piece, table, snapshots):
+    """Write a finished piece (positions ``piece``): its snapshots first, so that a result
+    file always has its snapshots, then its results, each atomically.  The files carry
+    the sweep's fingerprint and their positions, not the configuration."""
+    meta = io.provenance(sweep_fingerprint=fingerprint, positions=[piece.start, piece.stop])
+    name = io.CHUNK_PATTERN.format(piece.start, piece.stop)
+    if snapshots is not None:
+        os.makedirs(os.path.join(out, io.SNAPSHOT_DIR), exist_ok=True)
+        io.write_table_atomically(snapshots.replace_schema_metadata(meta),
+                                  os.path.join(out, io.SNAPSHOT_DIR, name))
+    io.write_table_atomically(table.replace_schema_metadata(meta), os.path.join(out, name))
+
+
+def run_piece(config, piece, threads=None, out=None, fingerprint=None):
+    """One task of a sweep (what a Dask worker runs): :func:`run_chunk` on the positions
+    ``piece`` with ``threads`` Numba threads (None: the process's default).  With ``out``
+    the worker writes the piece itself and returns only (piece, case_id and status);
+    without, it returns (piece, results, snapshots) for the caller to write."""
+    import numba
+
+    if threads:
+        numba.set_num_threads(min(int(threads), numba.config.NUMBA_NUM_THREADS))
+    table, snapshots = run_chunk(config, piece, numba.get_num_threads())
+    if out is None:
+        return piece, table, snapshots
+    write_piece(out, fingerprint, piece, table, snapshots)
+    return piece, table.select(["case_id", "status"]), None
+
+
+# ---- progress in a terminal or a log file ----------------------------------------------
+def case_weight(case):
+    """Estimated relative cost of a case, for the ETA: n², times 3 when q0 > 11 (3D loops:
+    2.7× the RHS evaluations of stable ones in README "Ensemble benchmark"; one RHS costs
+    about n^1.7)."""
+    theta = case.get("theta0_deg", math.nan)
+    q0 = diagnostics.stability_parameter(case["g0"], theta) if math.isfinite(theta) else 0.0
+    return case["n"] ** 2 * (3.0 if q0 > 11.0 else 1.0)
+
+
+def _duration(seconds):
+    if not math.isfinite(seconds):
+        return "?"
+    seconds = int(round(seconds))
+    return f"{seconds // 3600}h{seconds // 60 % 60:02d}m{seconds % 60:02d}s"
+
+
 class Progress:
-    """One status line on stderr: done/total, rate, ETA, failures (quiet: final line only)."""
+    """Progress on stderr: a live line in a terminal; in a log file (not a TTY) one line
+    every ``interval`` seconds, and a last one at the end.  Done/total, rate, ETA weighted
+    by :func:`case_weight`, failures.  ``quiet``: nothing."""
 
-    def __init__(self, total, done, quiet=False, stream=sys.stderr):
-        self.total, self.done, self.failures = total, done, 0
-        self.quiet, self.stream = quiet, stream
-        self.start, self.started_with = time.perf_counter(), done
-        self.live = not quiet and stream.isatty()
+    def __init__(self, weights, done_ids, quiet=False, stream=None, interval=30.0):
+        self.stream = sys.stderr if stream is None else stream
+        self.weights = weights  # {case_id: weight} of the cases this run is responsible for
+        self.total, self.done, self.failures = len(weights), len(done_ids), 0
+        self.weight_left = sum(weights.values()) - sum(weights[i] for i in done_ids)
+        self.weight_run, self.cases_run = 0.0, 0
+        self.start = self.last = time.perf_counter()
+        self.quiet, self.interval = quiet, interval
+        self.live = not quiet and self.stream.isatty()
 
-    def update(self, cases, failures):
-        self.done += cases
+    def update(self, case_ids, failures):
+        self.done += len(case_ids)
+        self.cases_run += len(case_ids)
         self.failures += failures
+        weight = sum(self.weights.get(i, 0.0) for i in case_ids)
+        self.weight_run += weight
+        self.weight_left -= weight
+        now = time.perf_counter()
         if self.live:
             self.stream.write("\r" + self._line())
             self.stream.flush()
+        elif not self.quiet and now - self.last >= self.interval:
+            self.stream.write(self._line() + "\n")
+            self.stream.flush()
+            self.last = now
 
     def _line(self):
         elapsed = time.perf_counter() - self.start
-        rate = (self.done - self.started_with) / elapsed if elapsed > 0 else 0.0
-        eta = (self.total - self.done) / rate if rate > 0 else float("nan")
-        eta_text = f"{eta:6.0f}s" if math.isfinite(eta) else "     ?"
-        return (f"cases {self.done}/{self.total} ({100 * self.done / self.total:3.0f}%) "
-                f"{rate:6.2f} case/s ETA {eta_text} failures {self.failures}")
+        rate = self.cases_run / elapsed if elapsed > 0 else 0.0
+        eta = (elapsed * max(self.weight_left, 0.0) / self.weight_run if self.weight_run
+               else math.nan)
+        return (f"cases {self.done}/{self.total} ({100 * self.done / max(self.total, 1):3.0f}%) "
+                f"{rate:6.2f} case/s elapsed {_duration(elapsed)} ETA {_duration(eta)} "
+                f"failures {self.failures}")
 
     def close(self):
-        self.stream.write(("\r" if self.live else "") + self._line() + "\n")
-        self.stream.flush()
+        if not self.quiet:
+            self.stream.write(("\r" if self.live else "") + self._line() + "\n")
+            self.stream.flush()
 
 
-def _prepare_directory(out, config, command_line):
-    """Create or check ``out``: a sweep directory holds one configuration only.  Nothing
-    is removed unless the configuration matches, and then only dead processes' temporaries."""
-    os.makedirs(out, exist_ok=True)
-    path = os.path.join(out, CONFIG_FILE)
-    stored = dict(config=config.as_dict(), command_line=command_line)
-    if os.path.exists(path):
-        with open(path) as handle:
-            previous = json.load(handle)["config"]
-        current = json.loads(json.dumps(config.as_dict()))
-        if previous != current:
-            changed = sorted(k for k in set(previous) | set(current) if previous.get(k) != current.get(k))
-            raise ValueError(f"{out!r} holds a different sweep (differs in: {', '.join(changed)}); "
-                             "use another --out")
-    _check_chunks_belong(out, config)
-    io.remove_stale_temporaries(out)
-    if os.path.exists(path):
+# ---- stopping on a signal ----------------------------------------------------------------
+class SweepInterrupted(KeyboardInterrupt):
+    """A sweep stopped by SIGINT or SIGTERM; every finished case was written first.
+    ``exit_status``: 128 + the signal number (130, 143)."""
+
+    def __init__(self, signum, out, done, total):
+        super().__init__(f"interrupted by {signal.Signals(signum).name}")
+        self.signum, self.out, self.done, self.total = signum, out, done, total
+        self.exit_status = 128 + signum
+
+
+@contextlib.contextmanager
+def _stop_on_signals(stop):
+    """While running, SIGINT and SIGTERM set ``stop`` (a threading.Event, its ``signum``
+    attribute the signal) instead of raising: the sweep notices within 0.1 s, writes
+    what has finished and raises :class:`SweepInterrupted`.  Outside the main thread
+    (no signals there) this does nothing."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
         return
-    tmp = path + ".tmp"
-    with open(tmp, "w") as handle:
-        json.dump(stored, handle, indent=1)
-    os.replace(tmp, path)
+
+    def handler(signum, frame):
+        stop.signum = signum
+        stop.set()
+
+    previous = {s: signal.signal(s, handler) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for s, h in previous.items():
+            signal.signal(s, h)
 
 
-def _check_chunks_belong(out, config):
-    """Refuse a directory whose chunk files were written by another sweep (a lost or
-    replaced sweep.json must not make old rows pass for new ones)."""
+def _in_background(stop, function, *args):
+    """function(*args) in a daemon thread, waited for in slices of 0.1 s; its result (its
+    exception re-raised), or None once ``stop`` is set: then the thread runs on unused
+    (a Numba kernel cannot be cut short; the process is about to exit)."""
+    box = {}
+
+    def target():
+        try:
+            box["result"] = function(*args)
+        except BaseException as exc:  # noqa: BLE001 - handed to the waiting thread
+            box["error"] = exc
+
+    thread = threading.Thread(target=target, daemon=True, name="loopsim-sweep-unit")
+    thread.start()
+    while thread.is_alive():
+        thread.join(0.1)
+        if stop.is_set():
+            return None
+    if "error" in box:
+        raise box["error"]
+    return box["result"]
+
+
+# ---- the sweep directory -----------------------------------------------------------------
+def _prepare_directory(out, config, command_line):
+    """Create or check ``out`` and return the configuration's fingerprint.  A directory
+    holds one configuration: every result file must carry its fingerprint.  Files wholly
+    contained in another (a piece written on interrupt and later recomputed by a side-by-
+    side identical sweep) are redundant and removed; partial overlaps are refused.  Then
+    only dead processes' temporaries are removed."""
+    io.check_layout(out)
+    os.makedirs(out, exist_ok=True)
     current = json.loads(json.dumps(config.as_dict()))
-    for chunk, path in io.numbered_files(out).items():
-        stored = io.read_metadata(path).get("sweep_config")
-        if stored != current or chunk >= config.n_chunks:
-            raise ValueError(f"{path!r} belongs to a different sweep than this command's; "
-                             "use another --out, or move that file away")
+    fingerprint = io.config_fingerprint(current)
+    stored = io.read_sweep_file(out)
+    if stored is not None and stored["fingerprint"] != fingerprint:
+        previous = stored["config"]
+        changed = sorted(k for k in set(previous) | set(current)
+                         if k not in io.FINGERPRINT_IGNORES and previous.get(k) != current.get(k))
+        raise ValueError(f"{out!r} holds a different sweep (differs in: "
+                         f"{', '.join(changed) or 'its fingerprint'}); use another --out")
+    files = io.chunk_files(out)
+    io.check_files_belong(dict(config=current, fingerprint=fingerprint), files)
+    _remove_contained(out, files, len(config.cases))
+    io.check_no_overlap(io.chunk_files(out))
+    io.remove_stale_temporaries(out)
+    io.remove_stale_temporaries(os.path.join(out, io.SNAPSHOT_DIR))
+    if stored is None:
+        io.write_json_atomically(dict(
+            layout=io.LAYOUT, fingerprint=fingerprint, config=current, command_line=command_line,
+            field_notes=FIELD_NOTES, reruns=[], **json.loads(json.dumps(io.provenance()))),
+            os.path.join(out, io.SWEEP_FILE))
+    return fingerprint
 
 
-def finished_chunks(out):
-    return set(io.numbered_files(out))
+def _remove_contained(out, files, count):
+    """Remove result files (and their snapshots) whose positions another file holds too,
+    once that file's rows are checked to be the cases its name says."""
+    import pyarrow.parquet as pq
+
+    widest = None
+    for start, stop in sorted(files, key=lambda key: (key[0], -key[1])):
+        if widest is not None and start >= widest[0] and stop <= widest[1]:
+            ids = pq.read_table(files[widest], columns=["case_id"]).column("case_id")
+            io.check_rows(files[widest], widest, ids.to_pylist(), count)
+            name = os.path.basename(files[start, stop])
+            for path in (os.path.join(out, io.SNAPSHOT_DIR, name), files[start, stop]):
+                if os.path.exists(path):
+                    os.remove(path)
+        elif widest is None or stop > widest[1]:
+            widest = (start, stop)
 
 
-def run_sweep(config, out, threads=None, quiet=False, command_line=None):
-    """Run (or resume) a sweep into directory ``out``; returns the results DataFrame."""
+def _covered_ids(config, covered):
+    order = case_order(len(config.cases))
+    return [order[p] for low, high in covered for p in range(low, high)]
+
+
+def _failures(table):
+    return sum(1 for s in table.column("status").to_pylist() if s != "ok")
+
+
+# ---- running -------------------------------------------------------------------------------
+def _run_unit(config, part, threads):
+    import numba
+
+    numba.set_num_threads(threads)  # per thread in Numba: set in the thread that runs
+    return run_chunk(config, part, threads)
+
+
+def _run_local(config, out, fingerprint, pieces, threads, unit, progress, stop):
+    """The pieces on this machine's threads, each in units of ``unit`` positions; on a
+    stop request the finished units of the running piece are written as a shorter piece."""
+    for piece in pieces:
+        finished, tables, snapshots = piece.start, [], []
+        while finished < piece.stop:
+            part = range(finished, min(finished + unit, piece.stop))
+            result = _in_background(stop, _run_unit, config, part, threads)
+            if result is None:
+                break
+            tables.append(result[0])
+            if result[1] is not None:
+                snapshots.append(result[1])
+            finished = part.stop
+            progress.update(result[0].column("case_id").to_pylist(), _failures(result[0]))
+        if finished > piece.start:
+            write_piece(out, fingerprint, range(piece.start, finished), pa.concat_tables(tables),
+                        pa.concat_tables(snapshots) if snapshots else None)
+        if stop.is_set():
+            return
+
+
+def _dask_client(scheduler, workers):
+    """(client, cluster or None): connected to ``scheduler``, or to a new LocalCluster of
+    ``workers`` processes, one task at a time each."""
+    import logging
+
+    from dask.distributed import Client, LocalCluster
+
+    if scheduler is not None:
+        return Client(scheduler, timeout="30s"), None
+    # NUMBA_NUM_THREADS is left alone: a worker process that compiles re-reads it and
+    # refuses a value other than the one its thread pool started with (seen with env=
+    # here); each task sets its own thread count instead (run_piece)
+    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                           dashboard_address=None, silence_logs=logging.ERROR)
+    return Client(cluster), cluster
+
+
+def _close_cluster(cluster, grace):
+    """Close a LocalCluster; with ``grace`` (seconds, after a signal) its worker processes,
+    busy in a kernel that cannot be cut short, are killed rather than waited for."""
+    if grace is None:
+        cluster.close()
+        return
+    for nanny in cluster.workers.values():
+        try:
+            nanny.process.process.kill()
+        except Exception:  # noqa: BLE001 - gone already, or another distributed layout
+            pass
+    cluster.close(timeout=grace)
+
+
+def _run_dask(config, out, fingerprint, pieces, threads, progress, stop, client, write):
+    """The pieces as Dask tasks (one per piece); the configuration is sent once to every
+    worker.  ``write``: "worker" (each worker writes its piece into ``out``, a shared
+    directory) or "client" (results come back and this process writes them)."""
+    shared = client.scatter(config, broadcast=True)
+    futures = [client.submit(run_piece, shared, piece, threads,
+                             out if write == "worker" else None, fingerprint, pure=False)
+               for piece in pieces]
+    pending = set(futures)
+    try:
+        while pending and not stop.is_set():
+            finished = [f for f in pending if f.done()]
+            if not finished:
+                stop.wait(0.05)
+                continue
+            for future in finished:
+                pending.discard(future)
+                piece, table, snapshots = future.result()
+                if write == "client":
+                    write_piece(out, fingerprint, piece, table, snapshots)
+                progress.update(table.column("case_id").to_pylist(), _failures(table))
+    finally:
+        if pending:
+            client.cancel(list(pending))
+
+
+def run_sweep(config, out, threads=None, quiet=False, command_line=None, *, scheduler=None,
+              local_cluster=False, workers=None, shard=None, unit=None, write="client",
+              progress_interval=30.0, stream=None):
+    """Run (or resume) a sweep into directory ``out``; returns the results DataFrame.
+
+    Backends: this machine's Numba threads (default; ``threads``, default all cores), a
+    Dask cluster at ``scheduler`` or, with ``local_cluster``, a new Dask LocalCluster
+    of ``workers`` processes (``threads`` Numba threads each, default 1).  ``shard``
+    (i, n): only the chunks k with k % n == i (job arrays).  ``unit``: positions per
+    kernel call on the local backend (default: ``threads``, one case per lane, so a
+    signal loses at most the cases in flight; on a loaded 2-core machine 32 cases ran
+    in 36.5 s with units of 32, 36.9 s with 8 and 27.5 s with 2: no measurable cost).
+    SIGINT/SIGTERM: finished cases are written, then :class:`SweepInterrupted` is
+    raised (the running kernel call's cases are lost).
+    ``write`` (Dask): "client" (default: pieces come back and this process writes them;
+    no shared filesystem needed) or "worker" (each worker writes its pieces into ``out``,
+    which it must see at the same path); measured equal (README "Dask and job arrays").
+    """
     import numba
 
     validate(config)
-    _prepare_directory(out, config, command_line or [])
-    threads = threads or numba.config.NUMBA_NUM_THREADS
-    numba.set_num_threads(threads)
-    done = finished_chunks(out)
-    progress = Progress(len(config.cases), sum(len(chunk_case_ids(config, c)) for c in done), quiet)
-    metadata = io.provenance(
-        sweep_config=config.as_dict(), thresholds=dataclasses.asdict(config.thresholds),
-        command_line=command_line or [], field_notes=FIELD_NOTES,
-    )
-    for chunk in range(config.n_chunks):
-        if chunk in done:
-            continue
-        table, snapshots = run_chunk(config, chunk, threads)
-        table = table.replace_schema_metadata(metadata)
-        if snapshots is not None:  # written before the chunk: a finished chunk has its snapshots
-            io.write_table_atomically(snapshots.replace_schema_metadata(metadata),
-                                      os.path.join(out, SNAPSHOT_PATTERN.format(chunk)))
-        io.write_table_atomically(table, os.path.join(out, CHUNK_PATTERN.format(chunk)))
-        failures = sum(1 for s in table.column("status").to_pylist() if s != "ok")
-        progress.update(table.num_rows, failures)
+    if shard is not None and not (0 <= shard[0] < shard[1]):
+        raise ValueError(f"shard must be I/N with 0 <= I < N, got {shard[0]}/{shard[1]}")
+    distributed = scheduler is not None or local_cluster
+    if write not in ("worker", "client"):
+        raise ValueError(f"write must be 'worker' or 'client', got {write!r}")
+    fingerprint = _prepare_directory(out, config, command_line or [])
+    covered = io.chunk_files(out)
+    pieces = pending_pieces(config, covered, shard)
+    mine = _covered_ids(config, [(c.start, c.stop) for k, c in enumerate(canonical_chunks(config))
+                                 if shard is None or k % shard[1] == shard[0]])
+    done = set(_covered_ids(config, covered)) & set(mine)
+    progress = Progress({i: case_weight(config.cases[i]) for i in mine}, done, quiet, stream,
+                        progress_interval)
+    stop = threading.Event()
+    stop.signum = None
+    with _stop_on_signals(stop):
+        if distributed and pieces:
+            workers = workers or max(1, numba.config.NUMBA_NUM_THREADS // (threads or 1))
+            client, cluster = _dask_client(scheduler, workers)
+            try:
+                _run_dask(config, out, fingerprint, pieces, threads or (1 if cluster else None),
+                          progress, stop, client, write)
+            finally:
+                grace = 1 if stop.is_set() else None  # on a signal: no waiting for tasks
+                client.close(**({} if grace is None else dict(timeout=grace)))
+                if cluster is not None:
+                    _close_cluster(cluster, grace)
+        elif pieces:
+            threads = threads or numba.config.NUMBA_NUM_THREADS
+            _run_local(config, out, fingerprint, pieces, threads, unit or threads, progress,
+                       stop)
     progress.close()
+    if stop.is_set():
+        raise SweepInterrupted(stop.signum, out, progress.done, progress.total)
     return io.read_results(out)
+
+
+# ---- rerunning the failed cases -------------------------------------------------------------
+def config_from_dict(stored):
+    """The SweepConfig of a stored configuration (``_sweep.json``'s ``config``)."""
+    fields = {f.name for f in dataclasses.fields(SweepConfig)}
+    values = {k: v for k, v in stored.items() if k in fields}
+    values["thresholds"] = Thresholds(**stored.get("thresholds", {}))
+    return SweepConfig(**values)
+
+
+def rerun_failed(out, method, rtol, atol, **backend):
+    """Rerun the failed cases of sweep ``out`` with another method or tolerances.
+
+    Attempt k is a sweep of its own in ``out/_reruns/k`` (the failed cases, the settings
+    changed, no snapshots): re-running the same call resumes it.  Once it is complete,
+    every result file holding those cases is rewritten with the new rows (its metadata
+    lists the attempt) after the original was copied to ``out/_reruns/k/replaced/``.
+    Returns (the results DataFrame, the number of cases rerun).  ``backend``: as for
+    :func:`run_sweep` (threads, quiet, scheduler, local_cluster, workers, ...).
+    """
+    stored = io.read_sweep_file(out) if os.path.isdir(out) else None
+    if stored is None:
+        raise ValueError(f"no sweep at {out!r} (no {io.SWEEP_FILE}) to rerun failed cases of")
+    io.check_layout(out)
+    base = config_from_dict(stored["config"])
+    settings = dict(method=method, rtol=rtol, atol=atol)
+    reruns = stored.get("reruns", [])
+    open_attempt = next((r for r in reruns if not r["merged"]), None)
+    if open_attempt is not None and open_attempt["settings"] != settings:
+        raise ValueError(f"rerun {open_attempt['attempt']} of {out!r} is unfinished with "
+                         f"{open_attempt['settings']}: finish it first (same options)")
+    if open_attempt is None:
+        frame = io.read_results(out)
+        failed = sorted(int(i) for i in frame.loc[frame["status"] != "ok", "case_id"])
+        if not failed:
+            return frame, 0
+        current = {key: frame.set_index("case_id").loc[failed, key].unique().tolist()
+                   for key in ("rtol", "atol")}
+        if (current["rtol"] == [rtol] and current["atol"] == [atol]
+                and base.method == method and not reruns):
+            raise ValueError(f"the failed cases of {out!r} ran with these settings already; "
+                             "give another --method, --rtol or --atol")
+        open_attempt = dict(attempt=len(reruns) + 1, settings=settings, case_ids=failed,
+                            merged=False)
+        stored["reruns"] = reruns + [open_attempt]
+        io.write_json_atomically(stored, os.path.join(out, io.SWEEP_FILE))
+    ids = open_attempt["case_ids"]
+    directory = os.path.join(out, io.RERUN_DIR, str(open_attempt["attempt"]))
+    config = dataclasses.replace(base, cases=[base.cases[i] for i in ids], snapshots_for=[],
+                                 **settings)
+    rerun = run_sweep(config, directory, **backend)
+    _merge_rerun(out, stored["fingerprint"], directory, open_attempt["attempt"],
+                 rerun.assign(case_id=[ids[i] for i in rerun["case_id"]]))
+    open_attempt["merged"] = True
+    io.write_json_atomically(stored, os.path.join(out, io.SWEEP_FILE))
+    return io.read_results(out), len(ids)
+
+
+def _merge_rerun(out, fingerprint, directory, attempt, rows):
+    """Put the rerun ``rows`` (case ids of the sweep) into the result files holding those
+    cases; a file already carrying ``attempt`` in its metadata is done (so a merge cut
+    short by a kill resumes)."""
+    import pyarrow.parquet as pq
+
+    replaced = os.path.join(directory, "replaced")
+    os.makedirs(replaced, exist_ok=True)
+    new = pa.Table.from_pandas(rows, schema=io.RESULT_SCHEMA, preserve_index=False)
+    by_id = set(rows["case_id"])
+    for (start, stop), path in sorted(io.chunk_files(out).items()):
+        meta = io.read_metadata(path)
+        if attempt in meta.get("reruns", []):
+            continue
+        table = pq.read_table(path, schema=io.RESULT_SCHEMA)
+        mask = [i in by_id for i in table.column("case_id").to_pylist()]
+        if not any(mask):
+            continue
+        io.write_table_atomically(pq.read_table(path),
+                                  os.path.join(replaced, os.path.basename(path)))
+        keep = table.filter(pa.array([not m for m in mask]))
+        ids = set(table.column("case_id").to_pylist())
+        fresh = new.filter(pa.array([i in ids for i in new.column("case_id").to_pylist()]))
+        merged = pa.concat_tables([keep, fresh]).sort_by("case_id")
+        meta = io.provenance(sweep_fingerprint=fingerprint, positions=[start, stop],
+                             reruns=meta.get("reruns", []) + [attempt])
+        io.write_table_atomically(merged.replace_schema_metadata(meta), path)

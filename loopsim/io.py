@@ -5,8 +5,11 @@ coefficient layout, the run or sweep configuration); files are written to a
 temporary name and renamed into place.
 """
 import datetime
+import functools
 import glob
+import hashlib
 import json
+import math
 import os
 import re
 import socket
@@ -33,14 +36,15 @@ COEFFICIENT_LAYOUT = (
 #: Summary fields, in order; they are also the sweep table's columns.
 INPUT_FIELDS = ("g0", "theta0_deg", "n", "q0", "t_end", "rtol", "atol", "w", "perturbation",
                 "seed")
-RUN_FIELDS = ("status", "t_final", "steps_accepted", "steps_rejected", "nfev", "njev", "nlu",
-              "wall_s")
+RUN_FIELDS = ("method", "n_used", "status", "t_final", "steps_accepted", "steps_rejected",
+              "nfev", "njev", "nlu", "wall_s", "tail_max")
 SUMMARY_FIELDS = INPUT_FIELDS + RUN_FIELDS + tuple(d.name for d in diagnostics.REGISTRY)
 
 _FLOAT = pa.float64()
 _INT = pa.int64()
 _SUMMARY_TYPES = {
-    "n": _INT, "seed": _INT, "status": pa.string(), "steps_accepted": _INT,
+    "n": _INT, "seed": _INT, "method": pa.string(), "n_used": _INT, "status": pa.string(),
+    "steps_accepted": _INT,
     "steps_rejected": _INT, "nfev": _INT, "njev": _INT, "nlu": _INT,
     **{d.name: pa.from_numpy_dtype(np.dtype(d.dtype)) for d in diagnostics.REGISTRY},
 }
@@ -74,11 +78,52 @@ def provenance(**extra):
             for key, value in meta.items()}
 
 
-#: Files of a sweep directory: chunk k and its snapshots, named exactly so.
-CHUNK_PATTERN = "chunk-{:05d}.parquet"
-SNAPSHOT_PATTERN = "snapshots-{:05d}.parquet"
-_CHUNK_NAME = re.compile(r"chunk-(\d{5})\.parquet")
-_SNAPSHOT_NAME = re.compile(r"snapshots-(\d{5})\.parquet")
+#: A sweep directory is a Parquet dataset: result files ``chunk-SSSSSSS-EEEEEEE.parquet`` at
+#: the top (positions [S, E) of the sweep's case order), everything else under names that
+#: dataset readers skip (a leading "_" or "."): the configuration once in ``_sweep.json``,
+#: snapshots in ``_snapshots/`` (same file names), reruns of failed cases in ``_reruns/``.
+SWEEP_FILE = "_sweep.json"
+SNAPSHOT_DIR = "_snapshots"
+RERUN_DIR = "_reruns"
+LAYOUT = 2
+CHUNK_PATTERN = "chunk-{:07d}-{:07d}.parquet"
+_CHUNK_NAME = re.compile(r"chunk-(\d{7,})-(\d{7,})\.parquet")
+#: Names of the first layout (loopsim 0.2.0 and before): refused with a one-line error.
+_OLD_LAYOUT = re.compile(r"sweep\.json|(chunk|snapshots)-\d{5}\.parquet")
+#: Configuration fields that change no row: left out of the fingerprint, so a resume may
+#: change them.
+FINGERPRINT_IGNORES = ("chunk_size",)
+
+
+@functools.lru_cache(maxsize=8)
+def case_order(count):
+    """Position -> case id for a sweep of ``count`` cases: p -> p * stride mod count, with
+    stride the integer nearest count / golden ratio that is coprime to count.  Neighbouring
+    positions lie far apart in the grid, so every chunk mixes cheap and costly corners; the
+    order depends on the case count only, never on the chunk size."""
+    stride = max(1, round(count * 0.6180339887498949))
+    while math.gcd(stride, count) != 1:
+        stride += 1
+    return tuple(p * stride % count for p in range(count))
+
+
+def check_rows(path, positions, case_ids, count):
+    """ValueError unless the result file ``path`` named for ``positions`` (start, stop)
+    holds exactly the cases of those positions (a copy under another name does not)."""
+    order = case_order(count)
+    if sorted(case_ids) != sorted(order[p] for p in range(*positions)):
+        raise ValueError(f"{path!r} holds other cases than its name says (a renamed copy?); "
+                         "move it away")
+
+
+def config_fingerprint(config):
+    """SHA-256 (first 16 hex digits) of a sweep configuration (a dict), without
+    ``FINGERPRINT_IGNORES``: every result file carries it, instead of the configuration."""
+    kept = {k: v for k, v in config.items() if k not in FINGERPRINT_IGNORES}
+    text = json.dumps(kept, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
 #: Temporary files are named .tmp-HOST-PID-*: only their owner, or a later process on the
 #: same host once the owner has died, may remove them.
 _TEMP_NAME = re.compile(r"\.tmp-(?P<host>.+)-(?P<pid>\d+)-[^-]*$")
@@ -107,26 +152,99 @@ def remove_stale_temporaries(directory):
             pass
 
 
-def numbered_files(directory, kind="chunk"):
-    """{k: path} of the chunk (or ``kind="snapshots"``) files of a sweep directory, named
-    exactly ``chunk-KKKKK.parquet``; any other ``chunk-*`` file (a stray copy) is ignored
-    with a warning naming it."""
-    pattern = _CHUNK_NAME if kind == "chunk" else _SNAPSHOT_NAME
+def check_layout(directory):
+    """One-line ValueError for a directory written by the first layout (``sweep.json``,
+    ``chunk-KKKKK.parquet``): it cannot be resumed or read by this version."""
+    if not os.path.isdir(directory):
+        return
+    old = sorted(name for name in os.listdir(directory) if _OLD_LAYOUT.fullmatch(name))
+    if old:
+        raise ValueError(
+            f"{directory!r} is a sweep directory of loopsim <= 0.2.0 ({old[0]}): this version "
+            "neither resumes nor reads it; re-run the sweep into a new --out (its chunk files "
+            f"stay readable with pandas.read_parquet({os.path.join(directory, 'chunk-*.parquet')!r}"
+            " file by file)")
+
+
+def chunk_files(directory, kind="chunk"):
+    """{(start, stop): path} of a sweep directory's result files (``kind="snapshots"``:
+    its snapshot files), named exactly ``chunk-SSSSSSS-EEEEEEE.parquet``; any other
+    ``chunk-*`` file (a stray copy) is ignored with a warning naming it."""
+    if kind == "snapshots":
+        directory = os.path.join(directory, SNAPSHOT_DIR)
     found = {}
-    for path in sorted(glob.glob(os.path.join(directory, f"{kind}-*"))):
-        match = pattern.fullmatch(os.path.basename(path))
-        if match is None:
+    for path in sorted(glob.glob(os.path.join(directory, "chunk-*"))):
+        match = _CHUNK_NAME.fullmatch(os.path.basename(path))
+        if match is None or int(match[1]) >= int(match[2]):
             warnings.warn(f"ignoring {path!r}: not a {kind} file of this sweep (stray copy?)",
                           stacklevel=2)
             continue
-        found[int(match[1])] = path
+        found[int(match[1]), int(match[2])] = path
     return found
+
+
+def overlapping(ranges):
+    """The first pair of position ranges (start, stop) that share a position, or None."""
+    ordered = sorted(ranges)
+    for first, second in zip(ordered, ordered[1:]):
+        if second[0] < first[1]:
+            return first, second
+    return None
+
+
+def read_sweep_file(directory):
+    """The decoded ``_sweep.json`` of a sweep directory, or None when there is none."""
+    path = os.path.join(directory, SWEEP_FILE)
+    if not os.path.exists(path):
+        return None
+    try:
+        with open(path) as handle:
+            stored = json.load(handle)
+        stored["fingerprint"], stored["config"]  # noqa: B018 - both must be there
+    except (ValueError, KeyError, TypeError) as exc:
+        raise ValueError(f"{path!r} is damaged ({type(exc).__name__}: {exc}); move it away and "
+                         "re-run the sweep's command to rewrite it") from None
+    return stored
+
+
+def _umask():
+    """The process umask (read without changing it where /proc allows)."""
+    try:
+        with open("/proc/self/status") as handle:
+            for line in handle:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except OSError:
+        pass
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def _temporary(directory, suffix):
+    """(fd, path) of a new temporary file in ``directory`` named for this host and process,
+    with the mode an ordinary ``open`` gives (0666 less the umask; mkstemp's is 0600)."""
+    fd, tmp = tempfile.mkstemp(prefix=_temporary_prefix(), suffix=suffix, dir=directory)
+    os.fchmod(fd, 0o666 & ~_umask())
+    return fd, tmp
+
+
+def write_json_atomically(data, path):
+    """Write JSON to a temporary file in the target directory, then rename into place."""
+    fd, tmp = _temporary(os.path.dirname(os.path.abspath(path)), ".json")
+    try:
+        with os.fdopen(fd, "w") as handle:
+            json.dump(data, handle, indent=1)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        raise
 
 
 def write_table_atomically(table, path):
     """Write to a temporary file in the target directory, then rename into place."""
-    directory = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(prefix=_temporary_prefix(), suffix=".parquet", dir=directory)
+    fd, tmp = _temporary(os.path.dirname(os.path.abspath(path)), ".parquet")
     os.close(fd)
     try:
         pq.write_table(table, tmp)
@@ -177,38 +295,82 @@ def read_metadata(path):
 
 
 def read_snapshots(out):
-    """Trajectory snapshots of the cases chosen with ``snapshots_for`` (a DataFrame)."""
-    paths = sorted(numbered_files(out, "snapshots").values()) if os.path.isdir(out) else []
+    """Trajectory snapshots of the cases chosen with ``snapshots_for`` (a DataFrame): the
+    snapshot files whose result file is there (one cut short has none)."""
+    if not os.path.isdir(out):
+        return pd.DataFrame()
+    check_layout(out)
+    finished = chunk_files(out)
+    paths = [p for key, p in sorted(chunk_files(out, "snapshots").items()) if key in finished]
     if not paths:
         return pd.DataFrame()
     frame = pa.concat_tables([pq.read_table(p) for p in paths]).to_pandas()
     return frame.sort_values(["case_id", "t"], kind="stable").reset_index(drop=True)
 
 
+def check_files_belong(stored, files):
+    """ValueError naming the first result file of ``files`` ({(start, stop): path}) that
+    does not carry the fingerprint of ``stored`` (the decoded ``_sweep.json``) or lies
+    beyond its cases."""
+    count = len(stored["config"]["cases"])
+    for (start, stop), path in sorted(files.items()):
+        meta = read_metadata(path)
+        if meta.get("sweep_fingerprint") != stored["fingerprint"] or stop > count:
+            raise ValueError(f"{path!r} belongs to a different sweep than this one's "
+                             f"configuration ({SWEEP_FILE}); use another --out, or move that "
+                             "file away")
+        if meta.get("positions") != [start, stop]:
+            raise ValueError(f"{path!r} holds other cases than its name says (a renamed "
+                             "copy?); move it away")
+
+
+def check_no_overlap(files):
+    """ValueError naming two result files that hold the same positions (cases)."""
+    pair = overlapping(files)
+    if pair is not None:
+        raise ValueError(f"{files[pair[1]]!r} repeats cases of {files[pair[0]]!r} (a copied file, "
+                         "or sweeps with different --chunk-size run at the same time); move "
+                         "one of them away")
+
+
 def read_results(out):
     """All finished cases of a sweep directory as a DataFrame sorted by case_id.
 
-    The sweep's metadata (configuration, thresholds, versions, command line)
+    The same rows as ``pandas.read_parquet(out)``, checked: every file must carry the
+    fingerprint of the configuration in ``_sweep.json``, and no case may appear twice.
+    The sweep's metadata (configuration, thresholds, versions, command line, reruns)
     is in ``frame.attrs["loopsim"]``.
     """
     if not os.path.isdir(out):
         raise ValueError(f"no sweep directory at {out!r}")
-    paths = sorted(numbered_files(out).values())
+    check_layout(out)
+    files = chunk_files(out)
+    stored = read_sweep_file(out)
+    if stored is None:
+        if not files:
+            return RESULT_SCHEMA.empty_table().to_pandas()
+        raise ValueError(f"{out!r} has result files but no {SWEEP_FILE} (the sweep's "
+                         "configuration): re-run the sweep's command to restore it")
+    check_files_belong(stored, files)
+    check_no_overlap(files)
+    paths = [files[key] for key in sorted(files)]
     if not paths:
         return RESULT_SCHEMA.empty_table().to_pandas()
-    configs = {p: read_metadata(p).get("sweep_config") for p in paths}
-    if len({json.dumps(c, sort_keys=True) for c in configs.values()}) > 1:
-        first = paths[0]
-        other = next(p for p in paths if configs[p] != configs[first])
-        raise ValueError(f"{out!r} mixes sweeps: {os.path.basename(other)!r} has another "
-                         f"configuration than {os.path.basename(first)!r}; move the foreign "
-                         "files away")
-    table = pa.concat_tables([pq.read_table(p, schema=RESULT_SCHEMA) for p in paths])
+    tables = []
+    for key in sorted(files):
+        tables.append(pq.read_table(files[key], schema=RESULT_SCHEMA))
+        check_rows(files[key], key, tables[-1].column("case_id").to_pylist(),
+                   len(stored["config"]["cases"]))
+    table = pa.concat_tables(tables)
     frame = table.to_pandas().sort_values("case_id", kind="stable").reset_index(drop=True)
     duplicated = frame["case_id"][frame["case_id"].duplicated()]
     if len(duplicated):
         raise ValueError(f"{out!r} holds case_id {int(duplicated.iloc[0])} more than once "
                          f"({len(duplicated)} duplicate rows): a chunk file was copied or "
                          "renamed; move the extra files away")
-    frame.attrs["loopsim"] = read_metadata(paths[0])
+    meta = read_metadata(paths[0])
+    meta.update(sweep_config=stored["config"], thresholds=stored["config"].get("thresholds"),
+                command_line=stored.get("command_line", []),
+                field_notes=stored.get("field_notes", {}), reruns=stored.get("reruns", []))
+    frame.attrs["loopsim"] = meta
     return frame

@@ -24,11 +24,16 @@ def _axes(ax, figsize):
     return ax.figure, ax
 
 
-def phase_diagram(frame, ax=None):
+#: The paper's empirical edges of the in-plane regime (§6, Figs. 5, 7 and 9), q = g0 sin θ0 / 3.
+PAPER_BAND = (10.5, 18.5)
+
+
+def phase_diagram(frame, ax=None, paper_band=False):
     """g0 against θ0 coloured by regime (hollow: the case is not resolved at its n, see
     ``ensemble.Thresholds.resolved``), with the curves g0 = 3 q_c / sin θ0 of the
     paper's linear stability (q_c = 14.561, wrong sign) and of the full linearisation of
-    the circle at the sweep's truncation (in-plane q_c ≈ 8.90, out-of-plane ≈ 10.65)."""
+    the circle at the sweep's truncation (in-plane q_c ≈ 8.90, out-of-plane ≈ 10.65).
+    ``paper_band``: also the paper's empirical in-plane band q = 10.5 and 18.5 (its Fig. 5)."""
     fig, ax = _axes(ax, (6.6, 4.0))
     q_paper = paper.critical_q(20)
     order = int(frame["n"].max())
@@ -49,6 +54,11 @@ def phase_diagram(frame, ax=None):
         q_sector = circle.critical_q(max(order, 3), sector)
         ax.plot(theta, 3 * q_sector / np.sin(np.radians(theta)), "k", ls=style, lw=1.2,
                 label=f"full linearisation,\n{sector}, q = {q_sector:.3f}")
+    if paper_band:
+        for i, q_band in enumerate(PAPER_BAND):
+            ax.plot(theta, 3 * q_band / np.sin(np.radians(theta)), color="0.55", ls="-.", lw=1.0,
+                    label=f"paper's empirical in-plane\nband, q = {PAPER_BAND[0]:g}, {PAPER_BAND[1]:g}"
+                    if i == 0 else None)
     ax.set_xlim(0, 92)
     ax.set_ylim(0, 1.05 * frame["g0"].max())
     ax.set_xlabel(r"initial tilt $\theta_0$ (deg)")

@@ -235,21 +235,28 @@ def test_foreign_and_duplicate_chunks_are_refused(tmp_path, capsys):
     assert main(_fast_sweep_argv(out)) == 0
     frame = loopsim.read_results(str(out))
     assert list(frame["case_id"]) == [0, 1]
+    first, second = sorted(out.glob("chunk-*.parquet"))
     # a lost sidecar, then a different sweep into the same directory: refused
-    (out / "sweep.json").unlink()
+    (out / "_sweep.json").unlink()
+    with pytest.raises(ValueError, match="no _sweep.json"):
+        loopsim.read_results(str(out))
     assert main(_fast_sweep_argv(out, g0="20,70")) == 2
     assert "belongs to a different sweep" in capsys.readouterr().err
-    assert not (out / "sweep.json").exists()
+    assert not (out / "_sweep.json").exists()
+    assert main(_fast_sweep_argv(out)) == 0  # the same sweep restores it, computes nothing
     # a stray copy is ignored with a warning (no duplicate rows)
-    (out / "chunk-00001 (copy).parquet").write_bytes((out / "chunk-00001.parquet").read_bytes())
+    copy = out / (second.stem + " (copy).parquet")
+    copy.write_bytes(second.read_bytes())
     with pytest.warns(UserWarning, match="stray copy"):
         frame = loopsim.read_results(str(out))
     assert list(frame["case_id"]) == [0, 1]
-    # a copy under a valid chunk name duplicates case ids: refused on read and on resume
-    (out / "chunk-00001 (copy).parquet").rename(out / "chunk-00005.parquet")
-    with pytest.raises(ValueError, match="more than once"):
+    # a copy under another valid name: its rows are not the cases its name says
+    copy.rename(out / "chunk-0000000-0000002.parquet")
+    with pytest.raises(ValueError, match="other cases than its name says"):
         loopsim.read_results(str(out))
     assert main(_fast_sweep_argv(out)) == 2
+    assert "other cases than its name says" in capsys.readouterr().err
+    assert first.exists() and second.exists()  # nothing removed on the strength of a name
 
 
 @pytest.mark.parametrize("content, words", [

@@ -17,7 +17,7 @@ import numba
 import numpy as np
 
 from ..config import JIT
-from ..models import constraint_error, rhs, steady_invariants
+from ..models import constraint_error, resolution_error, rhs, steady_invariants
 
 # ---- status codes: the driver never raises; a run ends with one of these ----
 OK = 0
@@ -26,6 +26,7 @@ STEP_UNDERFLOW = 2
 NON_FINITE = 3
 LENGTH_ERROR = 4
 STEADY = 5  # success: stopped early in a steady terminal state
+REFINE = 6  # not an end: the state outgrew its resolution; go on at a higher one
 SUCCESS = (OK, STEADY)
 STATUS_NAMES = {
     OK: "ok",
@@ -34,6 +35,7 @@ STATUS_NAMES = {
     NON_FINITE: "non-finite state",
     LENGTH_ERROR: "length error too large",
     STEADY: "ok",
+    REFINE: "not resolved at the highest truncation",
 }
 #: Why a run stopped, per status.
 STOP_REASONS = {**STATUS_NAMES, OK: "t_end", STEADY: "steady"}
@@ -49,13 +51,14 @@ STEADY_WINDOWS = 2
 
 StepOptions = collections.namedtuple(
     "StepOptions",
-    "rtol atol first_step min_step max_step max_steps constraint_tol steady_interval steady_tol",
+    "rtol atol first_step min_step max_step max_steps constraint_tol steady_interval steady_tol"
+    " resolution_tol",
 )
 
 
 def step_options(rtol, atol, first_step=None, min_step=0.0, max_step=np.inf,
                  max_steps=1_000_000, constraint_tol=np.inf, steady_interval=0.0,
-                 steady_tol=0.0):
+                 steady_tol=0.0, resolution_tol=np.inf):
     """Driver options (scipy names where they exist) as a ``StepOptions`` tuple.
 
     first_step: None selects the starting step automatically.
@@ -67,10 +70,13 @@ def step_options(rtol, atol, first_step=None, min_step=0.0, max_step=np.inf,
     (the change is scaled by steady_interval / elapsed time, so long implicit
     steps are judged like short ones) at STEADY_WINDOWS consecutive checks,
     stop with status STEADY.  steady_interval <= 0 disables the check.
+    resolution_tol: stop with REFINE once the model's ``resolution_error`` (for a loop:
+    the spectral tail) exceeds it after an accepted step (``refinement`` then goes on
+    at a higher truncation).
     """
     return StepOptions(float(rtol), float(atol), -1.0 if first_step is None else float(first_step),
                        float(min_step), float(max_step), int(max_steps), float(constraint_tol),
-                       float(steady_interval), float(steady_tol))
+                       float(steady_interval), float(steady_tol), float(resolution_tol))
 
 
 @numba.njit(**JIT)
@@ -157,6 +163,16 @@ def record_start(problem, y, t0, t_out, y_out, options):
 
 
 @numba.njit(**JIT)
+def initial_worst(problem, y):
+    """The monitors' record at the start (see :func:`monitor`): no constraint error yet
+    (the start's is the user's), no resolution error counted yet, the start's
+    resolution error as the previous one, not rising."""
+    worst = np.zeros(4)
+    worst[2] = resolution_error(problem, y)
+    return worst
+
+
+@numba.njit(**JIT)
 def landing(t, h, t_end):
     """Step to try from t: h, shortened to land exactly on t_end (or stretched by up to
     LANDING_STRETCH rather than leave a sliver).  Output times are not landed on: they
@@ -171,13 +187,27 @@ def landing(t, h, t_end):
 
 @numba.njit(**JIT)
 def monitor(problem, t, y, t_end, options, worst, next_check, previous, quiet):
-    """After an accepted step: constraint error and steady state.
+    """After an accepted step: constraint error, resolution and steady state.
 
-    Returns (status or -1 to go on, worst, next_check, previous, quiet).
+    ``worst`` (updated in place) = [largest |constraint error|, largest resolution
+    error once rising, the previous resolution error, rising (0 or 1)].  REFINE
+    comes as soon as the resolution error passes ``options.resolution_tol``; the
+    *record* counts it only from the first accepted step at which it grew, since the
+    decay of a start's own seeded high modes (rate ~k⁴) is the initial condition,
+    not dynamics that outgrew the truncation.  Returns (status or -1 to go on,
+    next_check, previous, quiet).
     """
-    worst = max(worst, abs(constraint_error(problem, y)))
-    if worst > options.constraint_tol:
-        return LENGTH_ERROR, worst, next_check, previous, quiet
+    worst[0] = max(worst[0], abs(constraint_error(problem, y)))
+    if worst[0] > options.constraint_tol:
+        return LENGTH_ERROR, next_check, previous, quiet
+    resolution = resolution_error(problem, y)
+    if resolution > worst[2]:
+        worst[3] = 1.0
+    worst[2] = resolution
+    if worst[3] > 0.0:
+        worst[1] = max(worst[1], resolution)
+    if resolution > options.resolution_tol:
+        return REFINE, next_check, previous, quiet
     if options.steady_interval > 0.0 and t >= next_check and t < t_end:
         current = steady_invariants(problem, y)
         # change per steady_interval, whatever the steps' length since the last check
@@ -185,10 +215,10 @@ def monitor(problem, t, y, t_end, options, worst, next_check, previous, quiet):
         change = max_abs_difference(current, previous) * options.steady_interval / elapsed
         quiet = quiet + 1 if change <= options.steady_tol else 0
         if quiet >= STEADY_WINDOWS:
-            return STEADY, worst, next_check, current, quiet
+            return STEADY, next_check, current, quiet
         previous = current
         next_check = t + options.steady_interval
-    return -1, worst, next_check, previous, quiet
+    return -1, next_check, previous, quiet
 
 
 @numba.njit(**JIT)

@@ -17,7 +17,8 @@ from ..config import JIT
 from ..models import rhs
 from .base import advance, attempt, dense_output, start, statistics
 from .control import (
-    NON_FINITE, OK, all_finite, initial_step, landing, monitor, record_start, stop_check,
+    NON_FINITE, OK, all_finite, initial_step, initial_worst, landing, monitor, record_start,
+    stop_check,
 )
 
 
@@ -46,11 +47,13 @@ def integrate(method, problem, y0, t0, t_end, t_out, options, y_out):
     to y_out[i] (exactly at t0 and t_end, by the method's dense output between
     steps).  Rows of y_out for times not reached are left untouched.
 
-    Returns (status, t, y, counts, max_constraint_error): counts (int64) =
-    [accepted steps, rejected steps, RHS evaluations, Jacobian evaluations, LU
-    factorisations] (``COUNTS``); max_constraint_error the largest
-    |constraint_error| seen at accepted steps (for a loop: the worst transient
-    relative length error).
+    Returns (status, t, y, counts, worst): counts (int64) = [accepted steps,
+    rejected steps, RHS evaluations, Jacobian evaluations, LU factorisations]
+    (``COUNTS``); worst[:2] = [largest |constraint_error| at the accepted steps,
+    largest resolution_error at the accepted steps once it has started to grow]
+    (``control.monitor``; worst[2:] is the monitor's state) (for a loop: the worst transient relative length
+    error and spectral tail).  Status REFINE (``options.resolution_tol`` exceeded) ends
+    the run at the step that outgrew the truncation.
     """
     counts = np.zeros(len(COUNTS), dtype=np.int64)
     ny = y0.shape[0]
@@ -61,8 +64,8 @@ def integrate(method, problem, y0, t0, t_end, t_out, options, y_out):
     f_old = np.empty(ny)
     n_acc = 0
     n_rej = 0
-    worst = 0.0
     t = t0
+    worst = initial_worst(problem, y)
     rhs(problem, y, f)
     n_rhs = 1
     if not all_finite(f) or not all_finite(y):
@@ -105,7 +108,7 @@ def integrate(method, problem, y0, t0, t_end, t_out, options, y_out):
                 n_rhs += dense_output(method, work, problem, y_old, f_old, y, f, h_try,
                                       (t_out[i_out] - t_old) / h_try, y_out[i_out])
             i_out += 1
-        stop, worst, next_check, previous, quiet = monitor(
+        stop, next_check, previous, quiet = monitor(
             problem, t, y, t_end, options, worst, next_check, previous, quiet)
         if stop >= 0:
             return stop, t, y, _counts(method, work, counts, n_acc, n_rej, n_rhs), worst

@@ -31,6 +31,14 @@ def constraint_error(problem, y):
 
 
 @generic
+def resolution_error(problem, y):
+    """How close the state is to the model's resolution limit (for a loop: the spectral
+    tail, the RMS relative amplitude of its top two Fourier modes); 0 for a model
+    without a truncation."""
+    raise NotImplementedError("only callable from jitted code")
+
+
+@generic
 def steady_invariants(problem, y):
     """Quantities (1-D array) whose standstill defines a steady terminal state."""
     raise NotImplementedError("only callable from jitted code")

@@ -31,7 +31,8 @@ from .. import spectral
 from ..config import JIT
 from ..linalg import least_squares_affine
 from .base import (
-    auxiliary, constraint_error, for_case, implements, jacobian, rhs, steady_invariants,
+    auxiliary, constraint_error, for_case, implements, jacobian, resolution_error, rhs,
+    steady_invariants,
 )
 
 #: Precomputed constant matrices of one truncation order, shared by all cases.
@@ -190,6 +191,28 @@ def relative_length_error(x, ops, ws):
     for i in range(ops.m):
         total += np.sqrt(ws.tangent[0, i] ** 2 + ws.tangent[1, i] ** 2 + ws.tangent[2, i] ** 2)
     return total / ops.m - 1.0
+
+
+@numba.njit(**JIT)
+def spectral_tail(x):
+    """RMS relative amplitude of the top modes k ≥ max(2, n − 1) of x (3, 2n+1):
+
+        sqrt(Σ_{k ≥ max(2, n-1)} E_k / Σ_{k ≥ 1} E_k),   E_k = ½ Σ_xyz (a_k² + b_k²)
+
+    (the same as ``diagnostics.spectral_tail``; 0 for a point).
+    """
+    n = (x.shape[1] - 1) // 2
+    first = max(2, n - 1)
+    total = 0.0
+    top = 0.0
+    for k in range(1, n + 1):
+        energy = 0.0
+        for c in range(3):
+            energy += x[c, k] ** 2 + x[c, n + k] ** 2
+        total += energy
+        if k >= first:
+            top += energy
+    return np.sqrt(top / total) if total > 0.0 else 0.0
 
 
 @numba.njit(**JIT)
@@ -368,6 +391,12 @@ def _loop_jacobian(problem, y, f, jac, work_y, work_f):
 def _loop_length_error(problem, y):
     k = y.shape[0] // 3
     return relative_length_error(y.reshape((3, k)), problem.ops, problem.ws)
+
+
+@implements(resolution_error, LoopProblem)
+def _loop_tail(problem, y):
+    k = y.shape[0] // 3
+    return spectral_tail(y.reshape((3, k)))
 
 
 @implements(steady_invariants, LoopProblem)

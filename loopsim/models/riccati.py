@@ -7,7 +7,8 @@ statuses of every registered integrator.
 import collections
 
 from .base import (
-    auxiliary, constraint_error, for_case, implements, jacobian, rhs, steady_invariants,
+    auxiliary, constraint_error, for_case, implements, jacobian, resolution_error, rhs,
+    steady_invariants,
 )
 
 RiccatiProblem = collections.namedtuple("RiccatiProblem", "rates")
@@ -35,6 +36,11 @@ def _riccati_jacobian(problem, y, f, jac, work_y, work_f):
 
 @implements(constraint_error, RiccatiProblem)
 def _no_constraint(problem, y):
+    return 0.0
+
+
+@implements(resolution_error, RiccatiProblem)
+def _no_truncation(problem, y):
     return 0.0
 
 

@@ -1,0 +1,132 @@
+"""Automatic truncation (``n="auto"``): each case runs at the smallest order that
+keeps it resolved.
+
+A case starts at the lowest order of its ladder (``orders``).  After every
+accepted step the driver measures the spectral tail, the RMS relative amplitude
+of the top two Fourier modes (``models.local_sbt.spectral_tail``); once it passes
+``tail_tol`` the driver stops with status REFINE, the state is zero-padded to the
+next order of the ladder (exact: the curve is unchanged, ``spectral.resize``) and
+the integration goes on from that time, with a fresh step-size start.  At the top
+order the tail is only recorded.  Orders are never lowered: a 3D loop that has
+settled into a near-circle is cheap at any order, so lowering would save little
+and would discard resolved modes (not measured to pay; see the README).
+
+Everything here is orchestration of the compiled driver, level by level: a level
+is one call of ``integrators.integrate`` (one case) or ``batch.integrate_cases``
+(many cases in parallel, each from its own time).
+"""
+import numpy as np
+
+from . import batch, integrators, models, spectral, validation
+from .config import AUTO_ORDERS, DEFAULT_N
+from .integrators.control import REFINE
+
+#: Where ``n="auto"`` starts for the tilted circle (the paper's resolution).
+AUTO_START = DEFAULT_N
+#: The ``method`` values a user may give: the integrators, or "auto" (:func:`auto_method`).
+METHOD_CHOICES = tuple(integrators.METHODS) + ("auto",)
+#: Above this q0 the circle is linearly unstable out of its plane (full linearisation,
+#: docs/stability.md): the case is expected to turn 3D.
+Q_OUT_OF_PLANE = 10.6493
+
+
+def auto_method(q0, n, refine):
+    """The integrator for a case: RKF45 for a fixed n ≤ 6 run expected to turn 3D (q0
+    above the out-of-plane threshold: short explicit steps are cheapest while the
+    shape changes fast), Radau IIA otherwise (stiffness grows like n⁴; stable and
+    in-plane loops settle and long implicit steps win).  Evidence: README, "Which
+    integrator"."""
+    return "rkf45" if (not refine and n <= 6 and q0 > Q_OUT_OF_PLANE) else "radau5"
+
+
+def orders(n_start, n_max):
+    """The ladder: ``config.AUTO_ORDERS`` strictly between n_start and n_max, with both
+    ends included (n_start ≤ n_max)."""
+    n_start = validation.check_integer("n", n_start, 1)
+    n_max = validation.check_integer("n_max", n_max, n_start)
+    return (n_start,) + tuple(n for n in AUTO_ORDERS if n_start < n < n_max) + (
+        (n_max,) if n_max > n_start else ())
+
+
+def merge_worst(worst, level_worst):
+    """The monitors' record after one more level: the length error is a property of the
+    state, carried across levels, so its maximum is over the whole run; the tail is a
+    property of the order, so it is the new level's (earlier orders stayed below
+    ``tail_tol`` until the step that left them)."""
+    return np.array([max(worst[0], level_worst[0]), level_worst[1]])  # drops monitor state
+
+
+def level_options(options, tail_tol, top):
+    """Driver options of one level: refine past ``tail_tol``, except at the top order."""
+    return options._replace(resolution_tol=np.inf if top else float(tail_tol))
+
+
+def integrate_case(method, g0, w, x0, t0, t_end, t_eval, options, ladder, tail_tol):
+    """One case up the ladder (from x0 (3, 2 ladder[0] + 1) at t0).
+
+    Returns (status, t_final, x_final, n_used, counts, worst, x_out): counts as
+    ``integrators.integrate``, summed over the levels; worst = [largest length error
+    over the whole run, largest spectral tail at n_used] (:func:`merge_worst`); n_used
+    the last order reached; x_out (len(t_eval), 3, 2 n_used + 1) the states at the
+    requested times (NaN where not reached), zero-padded to n_used.
+    """
+    x = np.asarray(x0, dtype=float)
+    t = t0
+    counts = np.zeros(len(integrators.COUNTS), dtype=np.int64)
+    worst = np.zeros(2)
+    outputs = {}
+    for level, n in enumerate(ladder):
+        x = spectral.resize(x, n)
+        pending = np.flatnonzero(t_eval >= t if level == 0 else t_eval > t)
+        y_out = np.full((pending.size, x.size), np.nan)
+        status, t, y, level_counts, level_worst = integrators.integrate(
+            method, models.local_sbt.make_problem(n, g0, w), x.ravel(), t, t_end,
+            t_eval[pending], level_options(options, tail_tol, level == len(ladder) - 1), y_out)
+        counts += level_counts
+        worst = merge_worst(worst, level_worst)
+        for row, i in enumerate(pending):
+            if t_eval[i] <= t:
+                outputs[i] = y_out[row].reshape(3, -1)
+        x = y.reshape(3, -1)
+        if status != REFINE:
+            break
+    x_out = np.full((t_eval.size,) + x.shape, np.nan)
+    for i, state in outputs.items():
+        x_out[i] = spectral.resize(state, n)
+    return int(status), float(t), x, n, counts, worst, x_out
+
+
+def integrate_cases(method, parameters, x0, t_end, options, ladder, tail_tol, cost=None):
+    """Many cases up the ladder, each level in the parallel batch kernel.
+
+    x0 (B, 3, 2 ladder[0] + 1); parameters (B, 2) = (g0, w).  Returns (x_final,
+    n_used, t_final, status, counts, worst): x_final a list of B arrays (3, 2 n_used
+    + 1); the others as ``batch.integrate_cases``, summed or maximised over levels.
+    """
+    cases = len(x0)
+    x = [np.asarray(xb, dtype=float) for xb in x0]
+    parameters = np.asarray(parameters, dtype=float).reshape(cases, -1)
+    cost = np.ones(cases) if cost is None else np.asarray(cost, dtype=float)
+    t_end = np.broadcast_to(np.asarray(t_end, dtype=float), (cases,))
+    t = np.zeros(cases)
+    status = np.full(cases, REFINE, dtype=np.int64)
+    counts = np.zeros((cases, len(integrators.COUNTS)), dtype=np.int64)
+    worst = np.zeros((cases, 2))
+    n_used = np.full(cases, ladder[0], dtype=np.int64)
+    for level, n in enumerate(ladder):
+        active = np.flatnonzero(status == REFINE)
+        if not active.size:
+            break
+        y_final, t_final, level_status, level_counts, level_worst = batch.integrate_cases(
+            method, models.local_sbt.make_operators(n), parameters[active],
+            np.array([spectral.resize(x[b], n).ravel() for b in active]), t_end[active],
+            level_options(options, tail_tol, level == len(ladder) - 1), cost=cost[active],
+            t0=t[active])
+        for row, b in enumerate(active):
+            x[b] = y_final[row].reshape(3, -1)
+            t[b] = t_final[row]
+            status[b] = level_status[row]
+            counts[b] += level_counts[row]
+            worst[b] = merge_worst(worst[b], level_worst[row])
+            n_used[b] = n
+    return x, n_used, t, status, counts, worst

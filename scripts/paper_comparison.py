@@ -1,0 +1,95 @@
+"""Numbers of docs/paper-comparison.md, from the tables scripts/make_figures.py writes.
+
+Usage: python scripts/paper_comparison.py [--runs runs]
+
+Reads (through ``loopsim.read_results``) the main job at n = 6 (runs/phase), the
+same grid at n = 4 and n = 8, the representative cases at n = 16 and n = 24 and
+the seed ensembles, and prints, per claim of the paper, the measured counts and
+ranges.  Missing tables are skipped with a note.
+"""
+import argparse
+import os
+
+import numpy as np
+
+import loopsim
+
+Q_STAR = 8.9001  # the circle's in-plane threshold (docs/stability.md)
+
+
+def load(runs, name):
+    path = os.path.join(runs, name)
+    try:
+        return loopsim.read_results(path)
+    except ValueError as exc:
+        print(f"# {name}: skipped ({str(exc).splitlines()[0]})")
+        return None
+
+
+def regimes(frame):
+    return ", ".join(f"{k} {v}" for k, v in sorted(frame["regime"].value_counts().items()))
+
+
+def describe(name, f):
+    print(f"\n## {name}: {len(f)} cases, n = {sorted(f['n'].unique())}: {regimes(f)}; "
+          f"resolved {int(f['resolved'].sum())}; steady before t_end {int((f['stop_reason'] == 'steady').sum())}")
+    stable, inplane, d3 = (f[f["regime"] == r] for r in ("stable", "in-plane", "3d"))
+    if len(stable):
+        print(f"settling angle, stable: max {stable['settling_angle_deg'].max():.4f} deg")
+    for label, rows in (("in-plane", inplane), ("3d", d3)):
+        if len(rows):
+            print(f"settling angle, {label}: max {rows['settling_angle_deg'].max():.3f} deg")
+    if len(stable) and len(f[f["regime"] != "stable"]):
+        print(f"largest stable q0 {stable['q0'].max():.3f}; smallest non-stable q0 "
+              f"{f[f['regime'] != 'stable']['q0'].min():.3f}")
+    if len(inplane):
+        print(f"in-plane q0: {len(inplane)} cases in [{inplane['q0'].min():.2f}, {inplane['q0'].max():.2f}]; "
+              f"inside 10.5 < q0 < 18.5: {int(((inplane['q0'] > 10.5) & (inplane['q0'] < 18.5)).sum())}")
+    if len(d3):
+        smaller = int((d3["theta_final_deg"] < d3["theta0_deg"]).sum())
+        flat = d3["theta_final_deg"] < 15
+        round_ = d3["aspect_ratio"] < 1.05
+        print(f"3d: smallest q0 {d3['q0'].min():.2f}; terminal tilt < initial in {smaller} of {len(d3)}; "
+              f"tilt < 15 deg in {int(flat.sum())}; aspect ratio < 1.05 in {int(round_.sum())}; "
+              f"both (near-horizontal circle) in {int((flat & round_).sum())}")
+        print(f"3d: terminal tilt quartiles {np.round(d3['theta_final_deg'].quantile([.25, .5, .75]).to_numpy(), 1)}"
+              f", aspect ratio quartiles {np.round(d3['aspect_ratio'].quantile([.25, .5, .75]).to_numpy(), 3)}"
+              f", terminal q > 18.5 in {int((d3['q_final'] > 18.5).sum())}")
+    low = f[f["q_final"] < Q_STAR]
+    if len(low):
+        print(f"terminal q < {Q_STAR}: {len(low)} cases, aspect ratio > 1.01 in "
+              f"{int((low['aspect_ratio'] > 1.01).sum())} (of them steady: "
+              f"{int(((low['aspect_ratio'] > 1.01) & (low['stop_reason'] == 'steady')).sum())})")
+
+
+def pairs(low, high, label):
+    """Cases of ``high`` (higher n) against the same (g0, θ0, seed) of ``low``."""
+    keys = ["g0", "theta0_deg", "seed"]
+    merged = high.merge(low, on=keys, suffixes=("", "_low"))
+    if not len(merged):
+        return
+    print(f"\n## {label}")
+    print("| g0 | θ0 | q0 | regime (low / high) | tilt (low / high) | aspect ratio (low / high) |")
+    for _, r in merged.iterrows():
+        print(f"| {r['g0']:.1f} | {r['theta0_deg']:g} | {r['q0']:.1f} | {r['regime_low']} / {r['regime']} | "
+              f"{r['theta_final_deg_low']:.1f} / {r['theta_final_deg']:.1f} | "
+              f"{r['aspect_ratio_low']:.3f} / {r['aspect_ratio']:.3f} |")
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--runs", default="runs")
+    args = parser.parse_args()
+    tables = {name: load(args.runs, name) for name in
+              ("phase", "phase_n4", "phase_n8", "resolved_n16", "resolved_n24", "seeds_n6", "seeds_n16")}
+    for name, frame in tables.items():
+        if frame is not None and len(frame):
+            describe(name, frame)
+    if tables["phase"] is not None and tables["resolved_n16"] is not None:
+        pairs(tables["phase"], tables["resolved_n16"], "n = 6 (main job) against n = 16")
+    if tables["resolved_n16"] is not None and tables["resolved_n24"] is not None:
+        pairs(tables["resolved_n16"], tables["resolved_n24"], "n = 16 against n = 24")
+
+
+if __name__ == "__main__":
+    main()

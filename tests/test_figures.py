@@ -1,0 +1,251 @@
+"""Figures (loopsim/figures.py, ``loopsim figures``, scripts/plot_trajectory.py).
+
+Figure functions are drawn from small synthetic tables (tilted ellipses with known
+tilt and aspect ratio), so these tests need no integration; the command line and
+the trajectory script run on a tiny real sweep and run (n = 4, short times).
+"""
+import os
+import runpy
+import subprocess
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pandas as pd  # noqa: E402
+import pytest  # noqa: E402
+
+from loopsim import diagnostics, figures, plots, spectral  # noqa: E402
+from loopsim.cli import main  # noqa: E402
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+N = 4
+THRESHOLDS = dict(paper=14.561, in_plane=8.9001, out_of_plane=10.6493)
+
+
+def ellipse(theta_deg, stretch=1.0, n=N, centre=(0.0, 0.0, 0.0)):
+    """Coefficients (3, 2n+1) of the ellipse [sin s, stretch cos s (cos θ, sin θ)] + centre:
+    tilt θ, aspect ratio (variances) stretch²."""
+    t = np.radians(theta_deg)
+    x = np.zeros((3, spectral.n_coeffs(n)))
+    x[:, 0] = centre
+    x[0, n + 1] = 1.0  # b1 of x: sin s
+    x[1, 1], x[2, 1] = stretch * np.cos(t), stretch * np.sin(t)  # a1 of y, z
+    return x
+
+
+def table(rows=12):
+    """A synthetic sweep table with the columns the figures read."""
+    g0 = np.repeat([20.0, 60.0, 150.0], 4)[:rows]
+    theta0 = np.tile([10.0, 30.0, 60.0, 85.0], 3)[:rows]
+    regimes = np.array(["stable", "in-plane", "3d", "failed"])[np.arange(rows) % 4]
+    records = []
+    for i, (g, t, regime) in enumerate(zip(g0, theta0, regimes)):
+        stretch = 1.0 if regime == "stable" else 1.3
+        theta_final = t if regime != "3d" else t / 2
+        x = ellipse(theta_final, stretch)
+        records.append(dict(
+            case_id=i, g0=g, theta0_deg=t, n=N, seed=0, q0=g * np.sin(np.radians(t)) / 3,
+            t_end=10.0, theta_final_deg=diagnostics.tilt_deg(x),
+            q_final=g * np.sin(np.radians(theta_final)) / 3,
+            aspect_ratio=diagnostics.aspect_ratio(x), regime=regime, resolved=bool(i % 3),
+            x_final=x.ravel().tolist()))
+    return pd.DataFrame(records)
+
+
+def trajectory(times=(0.0, 0.5, 1.0, 1.5, 2.0), g0=60.0, theta0=30.0):
+    """A synthetic trajectory table: a tilted circle that flattens and falls; multiplier of
+    the translating circle T = -1 + q cos s."""
+    q = g0 * np.sin(np.radians(theta0)) / 3
+    rows = []
+    for t in times:
+        x = ellipse(theta0, 1.0 + 0.1 * min(t, 1.0), centre=(0.0, 0.0, -65.0 * t))
+        multiplier = np.zeros(spectral.n_coeffs(N))
+        multiplier[0], multiplier[1] = -1.0, q
+        rows.append(dict(t=t, theta_deg=diagnostics.tilt_deg(x),
+                         aspect_ratio=diagnostics.aspect_ratio(x), x=x.ravel().tolist(),
+                         multiplier=multiplier.tolist()))
+    return pd.DataFrame(rows)
+
+
+@pytest.fixture(autouse=True)
+def close_figures():
+    yield
+    plt.close("all")
+
+
+def test_import_leaves_the_backend_alone():
+    code = ("import matplotlib; before = matplotlib.get_backend(); "
+            "import loopsim.figures, loopsim.plots, loopsim.cli; "
+            "assert matplotlib.get_backend() == before == 'svg', matplotlib.get_backend()")
+    env = dict(os.environ, MPLBACKEND="svg")
+    subprocess.run([sys.executable, "-c", code], check=True, env=env, cwd=ROOT)
+
+
+def test_ellipse_fixture_has_the_intended_tilt_and_aspect_ratio():
+    x = ellipse(30.0, 1.3)
+    assert diagnostics.tilt_deg(x) == pytest.approx(30.0, abs=1e-9)
+    assert diagnostics.aspect_ratio(x) == pytest.approx(1.69, rel=1e-12)
+
+
+def test_centred_curve_removes_only_the_mean():
+    x = ellipse(30.0, centre=(5.0, -7.0, -3000.0))
+    points = figures.centred_curve(x)
+    assert np.abs(points.mean(axis=1)).max() < 1e-2
+    assert np.abs(points).max() == pytest.approx(1.0, abs=1e-12)
+
+
+def test_gallery_draws_side_and_plane_views_in_regime_colours():
+    frame = table()
+    fig = figures.gallery(frame, theta0_deg=30.0)
+    cases = frame[frame["theta0_deg"] == 30.0]
+    assert len(fig.axes) == 2 * len(cases)
+    expected = [plots.REGIME_STYLE[r]["color"] for r in cases.sort_values("g0")["regime"]]
+    side = fig.axes[: len(cases)]
+    drawn = [matplotlib.colors.to_hex(ax.get_lines()[-1].get_color()) for ax in side]
+    assert drawn == [matplotlib.colors.to_hex(c) for c in expected]
+    # the side view of a loop at 30 degrees is a segment at 30 degrees
+    y, z = side[0].get_lines()[-1].get_data()
+    assert np.degrees(np.arctan2(np.ptp(z), np.ptp(y))) == pytest.approx(30.0, abs=0.5)
+
+
+def test_phase_diagram_paper_band_adds_the_two_empirical_curves():
+    frame = table()
+    plain = plots.phase_diagram(frame)
+    banded = plots.phase_diagram(frame, paper_band=True)
+    assert len(banded.axes[0].get_lines()) == len(plain.axes[0].get_lines()) + 2
+    theta, g0 = banded.axes[0].get_lines()[-1].get_data()
+    assert np.allclose(g0 * np.sin(np.radians(theta)) / 3, plots.PAPER_BAND[1])
+
+
+def test_phase_diagrams_one_panel_per_sweep():
+    fig = figures.phase_diagrams([table(), table(8)])
+    assert len(fig.axes) == 2
+
+
+def test_q_and_tilt_scatter_and_thresholds():
+    frame = table()
+    fig = figures.q_and_tilt(frame, thresholds=THRESHOLDS, reference=table(4))
+    left, right = fig.axes
+    levels = sorted(line.get_ydata()[0] for line in left.get_lines()[1:])
+    assert levels == pytest.approx(sorted([14.561, 8.9001, 10.6493, 10.5, 18.5]))
+    points = np.concatenate([c.get_offsets() for c in right.collections])
+    assert len(points) == len(frame) + 4
+
+
+def test_aspect_ratio_with_branch_solid_stable_dashed_unstable():
+    frame = table()
+    q = np.linspace(8.9, 25.0, 30)
+    branch = pd.DataFrame(dict(q=q, aspect_ratio=1 + 0.1 * (q - 8.9), stable_in_plane=True,
+                               stable_out_of_plane=q < 18.0))
+    fig = figures.aspect_ratio(frame, branch, q_max=20.0)
+    styles = {line.get_label(): line.get_linestyle() for line in fig.axes[0].get_lines()}
+    assert styles["steady shapes, stable"] == "-"
+    assert styles["steady shapes, unstable"] == "--"
+    solid = next(line for line in fig.axes[0].get_lines() if line.get_label() == "steady shapes, stable")
+    assert np.nanmax(solid.get_xdata()[np.isfinite(solid.get_ydata())]) < 18.6
+    assert fig.axes[0].get_xlim() == (0.0, 20.0)
+    assert any("not shown" in t.get_text() for t in fig.axes[0].texts)
+    assert len(figures.aspect_ratio(frame).axes[0].get_lines()) == 1  # no branch: y = 1 only
+
+
+def test_evolution_three_views_coloured_by_time_until_settled():
+    trace = trajectory(times=np.linspace(0.0, 4.0, 9))
+    assert figures.settling_index(trace) == 2  # the shape stops changing at t = 1
+    fig = figures.evolution(trace, snapshots=9)
+    ax3d, side, top = fig.axes[:3]
+    assert ax3d.name == "3d" and len(fig.axes) == 4  # + colour bar
+    assert len(side.get_lines()) == 3  # snapshots t = 0, 0.5, 1
+    for line in side.get_lines():
+        assert np.abs(line.get_xydata()).max() < 2.0  # centred, though it fell 65 per unit t
+    fig = figures.evolution(trace, snapshots=5, t_max=None)
+    assert len(fig.axes[1].get_lines()) == 5
+
+
+def test_tension_on_the_translating_circle_is_q_cos_s():
+    """N = T + |x''|² = q cos s on the circle with T = -1 + q cos s (physics notes)."""
+    trace = trajectory()
+    q = 60.0 * np.sin(np.radians(30.0)) / 3
+    fig = figures.tension_figure(trace.iloc[:1], rows=(0,))
+    lines = fig.axes[0].collections[0]
+    values = lines.get_array()
+    assert values.max() == pytest.approx(q, rel=1e-3)
+    assert values.min() == pytest.approx(-q, rel=1e-3)
+    assert len(fig.axes) == 2  # 3D axes and colour bar
+
+
+def test_stability_figure_from_tables():
+    q = np.linspace(0, 20, 11)
+    growth = pd.DataFrame(dict(q=q, paper=q - 14.5, corrected=q - 10.6, in_plane=q - 8.9,
+                               out_of_plane=q - 10.6))
+    critical = pd.DataFrame(dict(n=[3, 4, 5], in_plane=[np.nan, 9.8, 8.94],
+                                 out_of_plane=[12.0, 10.7, 10.65], paper=[17.3, 14.8, 14.6],
+                                 corrected=[12.0, 10.7, 10.65]))
+    fig = figures.stability(growth, critical)
+    left, right = fig.axes
+    assert len(left.get_lines()) == 4  # three curves and sigma = 0
+    assert len(right.get_lines()) == 3
+    assert len(right.get_lines()[1].get_xdata()) == 2  # NaN (no crossing) left out
+
+
+def test_seed_distributions_one_histogram_per_table():
+    frame = table(4)
+    fig = figures.seed_distributions([frame, frame], ["a", "b"])
+    left, right = fig.axes
+    assert len(left.patches) == 2 and len(right.patches) == 2
+
+
+# ---- real files: a tiny sweep, a tiny run -------------------------------------------
+@pytest.fixture(scope="module")
+def tiny(tmp_path_factory):
+    from loopsim import ensemble
+
+    base = tmp_path_factory.mktemp("tiny")
+    cases = ensemble.grid_cases([10.0, 60.0], [30.0, 60.0], [N], seeds=1)
+    ensemble.run_sweep(ensemble.SweepConfig(cases=cases, t_end=0.3), str(base / "sweep"), quiet=True)
+    run = base / "run.parquet"
+    assert main(["run", "--g0", "60", "--theta0", "30", "--n", str(N), "--t-end", "1",
+                 "--snapshots", "5", "--out", str(run)]) == 0
+    return base
+
+
+def test_cli_figures_on_a_tiny_sweep_and_run(tiny, capsys):
+    out = tiny / "figures"
+    assert main(["figures", str(tiny / "sweep"), str(tiny / "run.parquet"), "--out", str(out),
+                 "--only", "gallery,phase,q_tilt,aspect,evolution,tension", "--no-branch"]) == 0
+    names = sorted(os.listdir(out))
+    assert names == sorted(["fig4_gallery.png", "fig5_phase.png", "fig7_q_tilt.png",
+                            "fig8_aspect.png", "fig6_evolution_run.png", "fig1_tension_run.png"])
+    for name in names:
+        assert 5_000 < (out / name).stat().st_size < 300_000
+    assert "6 figures" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("args, word", [
+    (["{tmp}/missing", "--out", "{tmp}/o"], "no sweep directory"),
+    (["{sweep}", "{tmp}/garbage.parquet", "--out", "{tmp}/o"], "cannot read"),
+    (["{sweep}", "{tmp}/nothing.parquet", "--out", "{tmp}/o"], "no such file"),
+    (["{sweep}", "--out", "{tmp}/o", "--only", "fig99"], "unknown figure"),
+])
+def test_cli_figures_bad_input_is_one_line_exit_2(tiny, tmp_path, capsys, args, word):
+    (tmp_path / "garbage.parquet").write_bytes(b"not parquet at all")
+    args = [a.format(tmp=tmp_path, sweep=tiny / "sweep") for a in args]
+    assert main(["figures", *args]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("loopsim: error:") and word in err and err.count("\n") == 1
+
+
+def test_plot_trajectory_script_draws_the_loop_near_its_centroid(tiny, tmp_path, monkeypatch):
+    """scripts/plot_trajectory.py centres each snapshot on its centre of mass: the loop
+    fell ~65 per unit time, yet every drawn point lies within 3 radii of the centroid."""
+    drawn = {}
+    monkeypatch.setattr(plots, "save", lambda fig, path, dpi=200: drawn.setdefault("fig", fig))
+    script = runpy.run_path(os.path.join(ROOT, "scripts", "plot_trajectory.py"))
+    script["main"](str(tiny / "run.parquet"), str(tmp_path / "t.png"))
+    lines = drawn["fig"].axes[0].get_lines()
+    assert len(lines) == 5
+    extent = max(np.abs(line.get_xydata()).max() for line in lines)
+    assert 0.5 < extent < 3.0

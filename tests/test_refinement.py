@@ -1,0 +1,155 @@
+"""Automatic truncation (``n="auto"``, loopsim.refinement): the monitor, exact
+zero-padding on a change of n, a one-order ladder equal to the fixed-n driver, and the
+tail control's convergence to a fixed high-n run."""
+import numpy as np
+import pytest
+
+import loopsim
+from loopsim import diagnostics, integrators, models, refinement, shapes, spectral
+from loopsim.integrators.control import REFINE
+
+RADAU = integrators.METHODS["radau5"]
+
+
+def _options(**extra):
+    return integrators.step_options(1e-6, 1e-9, max_steps=200_000, constraint_tol=0.1, **extra)
+
+
+def test_ladder_orders():
+    assert refinement.orders(6, 32) == (6, 8, 12, 16, 20, 24, 32)
+    assert refinement.orders(6, 6) == (6,)
+    assert refinement.orders(10, 14) == (10, 12, 14)
+    with pytest.raises(ValueError, match="n_max"):
+        refinement.orders(8, 6)
+
+
+def test_spectral_tail_kernel_matches_the_diagnostic(rng):
+    for n in (2, 3, 6, 11):
+        x = rng.standard_normal((3, 2 * n + 1)) / (1 + np.arange(2 * n + 1))
+        assert models.local_sbt.spectral_tail(x) == pytest.approx(
+            diagnostics.spectral_tail(x, n), rel=1e-14)
+
+
+def test_zero_padding_is_exact(rng):
+    x = rng.standard_normal((3, 13))
+    padded = spectral.resize(x, 16)
+    s = np.linspace(0, 2 * np.pi, 57)
+    np.testing.assert_array_equal(spectral.resize(padded, 6), x)
+    np.testing.assert_allclose(spectral.evaluate(padded, s), spectral.evaluate(x, s),
+                               rtol=0, atol=1e-14)
+
+
+def test_driver_stops_with_refine_when_the_tail_passes_the_tolerance():
+    x0 = shapes.start_shape(60.0, 6, 1e-3, 0)[0]
+    tail0 = models.local_sbt.spectral_tail(x0)
+    problem = models.local_sbt.make_problem(6, 150.0, 10.0)
+    no_output = np.empty(0)
+    status, t, y, counts, worst = integrators.integrate(
+        RADAU, problem, x0.ravel(), 0.0, 10.0, no_output, _options(resolution_tol=3 * tail0),
+        np.empty((0, x0.size)))
+    assert status == REFINE and 0.0 < t < 10.0
+    assert models.local_sbt.spectral_tail(y.reshape(3, -1)) > 3 * tail0 == pytest.approx(
+        3 * tail0)
+    assert worst[1] > 3 * tail0
+    # without a tolerance the same run goes on past that time
+    status_free, t_free, *_ = integrators.integrate(
+        RADAU, problem, x0.ravel(), 0.0, t, no_output, _options(), np.empty((0, x0.size)))
+    assert status_free == integrators.OK and t_free == t
+
+
+def test_recorded_tail_counts_growth_not_the_relaxing_seeded_modes():
+    """A stable loop's seeded top modes decay from the start (tail 3.3e-4 at n = 6): the
+    recorded tail_max counts the tail only once it grows, so the stable loop's stays
+    tiny while an in-plane loop's (q = 10: it grows to ~1e-3 at n = 6) is recorded."""
+    x0 = shapes.start_shape(30.0, 6, 1e-3, 0)[0]
+    assert models.local_sbt.spectral_tail(x0) > 1e-4
+    stable = refinement.integrate_case(RADAU, 30.0, 10.0, x0, 0.0, 3.0, np.empty(0),
+                                       _options(), (6,), 1.0)
+    assert stable[0] == integrators.OK and stable[5][1] < 1e-8
+    in_plane = refinement.integrate_case(RADAU, 60.0, 10.0, x0, 0.0, 3.0, np.empty(0),
+                                         _options(), (6,), 1.0)
+    assert in_plane[5][1] > 1e-4
+
+
+def test_one_order_ladder_is_the_fixed_driver_bit_for_bit():
+    x0 = shapes.start_shape(45.0, 6, 1e-3, 3)[0]
+    t_eval = np.linspace(0.0, 1.0, 5)
+    y_out = np.full((5, x0.size), np.nan)
+    fixed = integrators.integrate(RADAU, models.local_sbt.make_problem(6, 80.0, 10.0),
+                                  x0.ravel(), 0.0, 1.0, t_eval, _options(), y_out)
+    status, t, x, n_used, counts, worst, x_out = refinement.integrate_case(
+        RADAU, 80.0, 10.0, x0, 0.0, 1.0, t_eval, _options(), (6,), 1e-12)
+    assert status == fixed[0] and t == fixed[1] and n_used == 6
+    np.testing.assert_array_equal(x.ravel(), fixed[2])
+    np.testing.assert_array_equal(counts, fixed[3])
+    np.testing.assert_array_equal(worst, fixed[4][:2])
+    np.testing.assert_array_equal(x_out.reshape(5, -1), y_out)
+
+
+def test_refinement_pads_exactly_and_keeps_the_earlier_trajectory():
+    """Before the first change of n the auto run is the n = 6 run, bit for bit (padded
+    with zeros); after it, the state carries on from the padded state."""
+    x0 = shapes.start_shape(60.0, 6, 1e-3, 0)[0]
+    tol = 3 * models.local_sbt.spectral_tail(x0)
+    problem = models.local_sbt.make_problem(6, 150.0, 10.0)
+    status, t_switch, *_ = integrators.integrate(
+        RADAU, problem, x0.ravel(), 0.0, 10.0, np.empty(0), _options(resolution_tol=tol),
+        np.empty((0, x0.size)))
+    assert status == REFINE
+    t_eval = np.array([0.0, 0.5 * t_switch, min(t_switch + 0.05, 1.0)])
+    y6 = np.full((3, x0.size), np.nan)
+    integrators.integrate(RADAU, problem, x0.ravel(), 0.0, 1.0, t_eval, _options(), y6)
+    _, t_final, x, n_used, _, worst, x_out = refinement.integrate_case(
+        RADAU, 150.0, 10.0, x0, 0.0, 1.0, t_eval, _options(), (6, 8, 12), tol)
+    assert n_used > 6 and t_final == 1.0
+    for i in (0, 1):  # before the switch: the n = 6 states, zero-padded
+        np.testing.assert_array_equal(x_out[i], spectral.resize(y6[i].reshape(3, -1), n_used))
+    assert np.all(x_out[i, :, 7:n_used + 1] == 0.0)
+    assert np.all(np.isfinite(x_out[2])) and np.abs(x_out[2, :, 7:n_used + 1]).max() > 0.0
+
+
+def test_tail_control_converges_to_the_fixed_high_order_run():
+    """In-plane loop (g0 = 60, θ0 = 30°, q = 10): the terminal aspect ratio of the auto
+    run approaches the fixed n = 20 run from the same curve as the tolerance shrinks."""
+    x0 = shapes.start_shape(30.0, 6, 1e-3, 0)[0]
+    t_end = 4.0
+    reference = refinement.integrate_case(RADAU, 60.0, 10.0, x0, 0.0, t_end, np.empty(0),
+                                          _options(), (20,), 1.0)
+    aspect_ref = diagnostics.aspect_ratio(reference[2])
+    errors, orders = [], []
+    for tol in (1e-3, 1e-4, 1e-5):
+        _, t, x, n_used, *_ = refinement.integrate_case(
+            RADAU, 60.0, 10.0, x0, 0.0, t_end, np.empty(0), _options(), (6, 8, 12, 16, 20), tol)
+        assert t == t_end
+        errors.append(abs(diagnostics.aspect_ratio(x) - aspect_ref))
+        orders.append(n_used)
+    assert orders == sorted(orders) and orders[-1] > orders[0]
+    assert errors[-1] < 1e-6 < errors[0]
+    assert errors[2] < errors[1] < errors[0]
+
+
+def test_models_without_truncation_never_refine():
+    problem = models.riccati.RiccatiProblem(np.array([-1.0, -2.0]))
+    options = integrators.step_options(1e-8, 1e-10, resolution_tol=0.0)
+    status, *_ = integrators.integrate(RADAU, problem, np.array([1.0, 0.5]), 0.0, 1.0,
+                                       np.empty(0), options, np.empty((0, 2)))
+    assert status == integrators.OK
+
+
+def test_simulate_auto_records_the_order_reached_and_the_method():
+    result = loopsim.simulate(150.0, 60.0, n="auto", n_max=12, method="auto",
+                              t_span=(0.0, 0.3), snapshots=3)
+    assert result.method == "radau5" and result.inputs["n"] == 6
+    assert result.n_used in (8, 12) and result.x.shape == (3, 3, 2 * result.n_used + 1)
+    assert result.tail_max > 0
+    summary = result.summary()
+    assert summary["n_used"] == result.n_used and summary["method"] == "radau5"
+    with pytest.raises(ValueError, match="n"):
+        loopsim.simulate(150.0, 60.0, n="automatic")
+
+
+def test_auto_method_by_expected_regime():
+    assert refinement.auto_method(20.0, 6, False) == "rkf45"  # 3D expected at n = 6
+    assert refinement.auto_method(5.0, 6, False) == "radau5"  # stable
+    assert refinement.auto_method(20.0, 16, False) == "radau5"  # stiff at high n
+    assert refinement.auto_method(20.0, 6, True) == "radau5"  # climbs

@@ -1,0 +1,263 @@
+"""Sweep directories as Parquet datasets; shards, chunk-size changes, Dask, signals, exit
+codes and reruns of failed cases (issue 13)."""
+import io as stdio
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pandas as pd
+import pyarrow.dataset as ds
+import pyarrow.parquet as pq
+import pytest
+
+import loopsim
+from loopsim import ensemble, io
+from loopsim.cli import main
+
+DETERMINISTIC = [c for c in io.RESULT_SCHEMA.names if c != "wall_s"]
+
+
+def config(**kwargs):
+    cases = ensemble.grid_cases([10.0, 60.0, 150.0], [30.0, 60.0], [4], seeds=1)
+    args = dict(cases=cases, t_end=0.3, chunk_size=2)
+    args.update(kwargs)
+    return ensemble.SweepConfig(**args)
+
+
+@pytest.fixture(scope="module")
+def reference(tmp_path_factory):
+    """The 6-case sweep run whole on this machine's threads, with snapshots of case 4."""
+    out = str(tmp_path_factory.mktemp("reference") / "s")
+    frame = ensemble.run_sweep(config(snapshots_for=[4], snapshot_count=3), out, threads=2,
+                               quiet=True)
+    return out, frame
+
+
+def same_rows(a, b):
+    pd.testing.assert_frame_equal(a[DETERMINISTIC].reset_index(drop=True),
+                                  b[DETERMINISTIC].reset_index(drop=True), check_exact=True)
+
+
+def test_dataset_readers_return_exactly_the_rows(reference):
+    out, frame = reference
+    assert sorted(os.listdir(out)) == ["_snapshots", "_sweep.json"] + sorted(
+        io.CHUNK_PATTERN.format(s, e) for s, e in [(0, 2), (2, 4), (4, 6)])
+    by_id = lambda f: f.sort_values("case_id").reset_index(drop=True)  # noqa: E731
+    same_rows(by_id(pd.read_parquet(out)), frame)
+    same_rows(by_id(ds.dataset(out).to_table().to_pandas()), frame)
+    same_rows(by_id(pq.read_table(out).to_pandas()), frame)
+    duckdb = pytest.importorskip("duckdb")
+    rows = duckdb.sql(f"SELECT * FROM read_parquet('{out}/*.parquet') ORDER BY case_id").df()
+    assert list(rows.columns) == list(frame.columns) and list(rows["case_id"]) == list(range(6))
+    pd.testing.assert_series_equal(rows["theta_final_deg"], frame["theta_final_deg"])
+    assert len(loopsim.read_snapshots(out)) == 3  # snapshots still read, from _snapshots/
+
+
+def test_configuration_stored_once_fingerprint_in_each_file(reference):
+    out, frame = reference
+    with open(os.path.join(out, "_sweep.json")) as handle:
+        stored = json.load(handle)
+    assert stored["config"]["t_end"] == 0.3 and len(stored["config"]["cases"]) == 6
+    for (start, stop), path in io.chunk_files(out).items():
+        meta = io.read_metadata(path)
+        assert "sweep_config" not in meta and "command_line" not in meta
+        assert meta["sweep_fingerprint"] == stored["fingerprint"] == io.config_fingerprint(
+            stored["config"])
+        assert meta["positions"] == [start, stop]
+    assert frame.attrs["loopsim"]["sweep_config"]["t_end"] == 0.3
+    assert io.config_fingerprint(dict(stored["config"], chunk_size=7)) == stored["fingerprint"]
+    assert io.config_fingerprint(dict(stored["config"], t_end=0.4)) != stored["fingerprint"]
+
+
+def test_files_follow_the_umask(tmp_path):
+    previous = os.umask(0o002)
+    try:
+        ensemble.run_sweep(config(cases=config().cases[:2]), str(tmp_path / "s"), quiet=True)
+    finally:
+        os.umask(previous)
+    for path in (tmp_path / "s").iterdir():
+        if path.is_file():
+            assert path.stat().st_mode & 0o777 == 0o664, path
+
+
+def test_old_layout_is_refused_in_one_line(tmp_path, capsys):
+    out = tmp_path / "old"
+    out.mkdir()
+    (out / "sweep.json").write_text("{}")
+    (out / "chunk-00000.parquet").write_bytes(b"PAR1")
+    with pytest.raises(ValueError, match="loopsim <= 0.2.0.*new --out"):
+        loopsim.read_results(str(out))
+    assert main(["sweep", "--g0", "10", "--theta0", "30", "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1 and "new --out" in err
+
+
+def test_shards_together_equal_the_whole_sweep(tmp_path, reference):
+    out = str(tmp_path / "s")
+    for i in range(3):
+        ensemble.run_sweep(config(snapshots_for=[4], snapshot_count=3), out, threads=1,
+                           quiet=True, shard=(i, 3))
+    same_rows(loopsim.read_results(out), reference[1])
+    pd.testing.assert_frame_equal(loopsim.read_snapshots(out), loopsim.read_snapshots(reference[0]))
+
+
+def test_changed_chunk_size_resumes_without_loss_or_duplicates(tmp_path, reference):
+    out = str(tmp_path / "s")
+    traced = dict(snapshots_for=[4], snapshot_count=3)  # as the reference
+    ensemble.run_sweep(config(chunk_size=2, **traced), out, quiet=True, shard=(0, 2))  # chunks 0, 2
+    assert sorted(io.chunk_files(out)) == [(0, 2), (4, 6)]
+    frame = ensemble.run_sweep(config(chunk_size=3, **traced), out, quiet=True)  # [0, 3), [3, 6)
+    assert sorted(io.chunk_files(out)) == [(0, 2), (2, 3), (3, 4), (4, 6)]
+    same_rows(frame, reference[1])
+
+
+def test_pieces_never_repeat_a_position():
+    cfg = config(cases=config().cases * 4, chunk_size=5)  # 24 cases
+    covered = {(0, 3): None, (3, 7): None, (12, 13): None}
+    pieces = ensemble.pending_pieces(cfg, covered)
+    positions = [p for piece in pieces for p in piece] + [0, 1, 2, 3, 4, 5, 6, 12]
+    assert sorted(positions) == list(range(24))
+    assert sorted(ensemble.case_order(24)) == list(range(24))
+
+
+def test_dask_local_cluster_equals_prange(tmp_path, reference):
+    pytest.importorskip("distributed")
+    out = str(tmp_path / "s")
+    frame = ensemble.run_sweep(config(snapshots_for=[4], snapshot_count=3), out, threads=1,
+                               quiet=True, local_cluster=True, workers=2)
+    same_rows(frame, reference[1])
+    pd.testing.assert_frame_equal(loopsim.read_snapshots(out), loopsim.read_snapshots(reference[0]))
+
+
+def test_progress_goes_to_a_log_file_with_a_cost_weighted_eta(monkeypatch):
+    clock = iter([0.0, 10.0, 20.0, 20.0, 25.0, 25.0, 25.0])
+    monkeypatch.setattr(ensemble.time, "perf_counter", lambda: next(clock))
+    stream = stdio.StringIO()  # not a TTY: whole lines, every `interval` seconds
+    weights = {0: 1.0, 1: 1.0, 2: 8.0}
+    progress = ensemble.Progress(weights, [], stream=stream, interval=15.0)
+    progress.update([0], 0)  # t = 10: before the interval, no line
+    progress.update([1], 1)  # t = 20: a line; the last case weighs 8 of 10: ETA 20 s x 8 / 2
+    progress.close()
+    lines = stream.getvalue().splitlines()
+    assert len(lines) == 2 and "\r" not in stream.getvalue()
+    assert lines[0].startswith("cases 2/3") and "failures 1" in lines[0]
+    assert "elapsed 0h00m20s ETA 0h01m20s" in lines[0], lines[0]
+    assert ensemble.case_weight(dict(g0=150.0, theta0_deg=60.0, n=4)) == 3 * ensemble.case_weight(
+        dict(g0=10.0, theta0_deg=30.0, n=4))
+    quiet = stdio.StringIO()
+    progress = ensemble.Progress(weights, [], quiet=True, stream=quiet, interval=0.0)
+    progress.update([0], 0)
+    progress.close()
+    assert quiet.getvalue() == ""
+
+
+def _sweep_command(out, *extra):
+    return [sys.executable, "-m", "loopsim", "sweep", "--g0", "10,300", "--theta0", "30,80",
+            "--n", "8", "--t-end", "40", "--threads", "1", "--chunk-size",
+            "4", "--out", str(out), *extra]
+
+
+@pytest.mark.parametrize("signum, status", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_signal_stops_promptly_keeps_finished_cases(tmp_path, signum, status):
+    """Case order at 4 cases: positions 0..3 are cases 0, 3, 2, 1 (g0 = 10 first: cheap);
+    one case per kernel call (--threads 1).  The signal lands while a 3D case (g0 = 300,
+    t = 40, n = 8: much longer than the bound below) runs: the sweep stops at once, writes
+    the finished case, says how to resume, exits 128 + signum."""
+    out = tmp_path / "s"
+    process = subprocess.Popen(_sweep_command(out, "--progress-every", "0.001"),
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    first = process.stderr.readline()  # a log-file progress line once case 0 is done
+    assert first.startswith("cases 1/4"), first + process.communicate()[1]
+    time.sleep(1.0)  # inside the 3D case (g0 = 300)
+    sent = time.monotonic()
+    process.send_signal(signum)
+    stdout, rest = process.communicate(timeout=60)
+    waited = time.monotonic() - sent
+    stderr = first + rest
+    assert process.returncode == status, stderr
+    assert waited < 5.0, f"stopped {waited:.1f} s after the signal"
+    assert "Traceback" not in stderr
+    assert "re-run the same command to resume" in stderr.splitlines()[-1]
+    frame = loopsim.read_results(str(out))
+    assert 0 in set(frame["case_id"]) and len(frame) < 4
+    assert not list(out.glob(".tmp-*"))
+
+
+def test_exit_status_and_rerun_of_failed_cases(tmp_path, capsys):
+    """A step budget of 150 fails rkf45 on a stable loop to t = 3 but not radau5 (about
+    60 steps), nor a flat unperturbed circle (steady after about 90): the failed case is
+    rerun alone, first with another rtol (still failing: exit status 1), then with
+    radau5; every attempt's rows are kept in _reruns/, the dataset holds each case once,
+    and a further call finds nothing to rerun."""
+    out = tmp_path / "s"
+    cases = ensemble.grid_cases([10.0, 60.0], [30.0], [4], seeds=1)
+    cases[0].update(theta0_deg=0.0, perturbation=0.0)  # a flat circle: steady at t = 1
+    first = ensemble.run_sweep(ensemble.SweepConfig(cases=cases, t_end=3.0, max_steps=150,
+                                                    chunk_size=1), str(out), quiet=True)
+    assert list(first["status"]) == ["ok", "step budget exhausted"]
+    assert main(["sweep", "--rerun-failed", str(out), "--t-end", "4"]) == 2  # not a rerun option
+    assert main(["sweep", "--rerun-failed", str(out), "--rtol", "1e-5", "--quiet"]) == 1
+    assert "--rerun-failed" in capsys.readouterr().err
+    assert main(["sweep", "--rerun-failed", str(out), "--method", "radau5", "--quiet"]) == 0
+    second = loopsim.read_results(str(out))
+    assert list(second["status"]) == ["ok", "ok"]
+    assert second.loc[1, "rtol"] == 1e-6 and second.loc[0, "rtol"] == 1e-6
+    same_rows(second.iloc[:1], first.iloc[:1])
+    assert [r["case_ids"] for r in second.attrs["loopsim"]["reruns"]] == [[1], [1]]
+    for attempt, rtol in ((1, 1e-6), (2, 1e-5)):  # rows each attempt replaced
+        kept = pd.concat(pd.read_parquet(p) for p in (out / "_reruns" / str(attempt)
+                                                       / "replaced").iterdir())
+        assert list(kept["case_id"]) == [1] and list(kept["rtol"]) == [rtol]
+        assert list(kept["status"]) == ["step budget exhausted"]
+    assert len(pd.read_parquet(out)) == 2
+    assert main(["sweep", "--rerun-failed", str(out), "--rtol", "1e-6", "--quiet"]) == 0
+    assert "reran 0 failed" in capsys.readouterr().out
+
+
+def test_resume_after_sigint_equals_uninterrupted_run(tmp_path):
+    """SIGINT mid-chunk: the finished cases of the running chunk are written as a shorter
+    piece; the resume computes the rest, nothing twice."""
+    args = ["sweep", "--g0", "20,80,160", "--theta0", "20,50,80", "--n", "4", "--t-end", "1.5",
+            "--chunk-size", "9", "--threads", "1", "--progress-every", "0.001"]
+    reference = tmp_path / "reference"
+    assert main(args + ["--quiet", "--out", str(reference)]) == 0
+    out = tmp_path / "s"
+    process = subprocess.Popen([sys.executable, "-m", "loopsim"] + args + ["--out", str(out)],
+                               stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    for _ in range(2):
+        line = process.stderr.readline()
+    assert line.startswith("cases 2/9"), line
+    process.send_signal(signal.SIGINT)
+    rest = process.communicate(timeout=60)[1]
+    assert process.returncode == 130, rest
+    (piece,) = io.chunk_files(str(out))  # one chunk of 9, cut short
+    assert piece[0] == 0 and 2 <= piece[1] < 9
+    assert main(args + ["--quiet", "--out", str(out)]) == 0
+    assert sorted(io.chunk_files(str(out))) == [piece, (piece[1], 9)]
+    same_rows(loopsim.read_results(str(out)), loopsim.read_results(str(reference)))
+
+
+@pytest.mark.parametrize("argv, word", [
+    (["--shard", "2/2"], "--shard"),
+    (["--shard", "x"], "--shard"),
+    (["--workers", "2"], "--workers needs --dask"),
+    (["--dask", "--scheduler", "tcp://h:1"], "not both"),
+    (["--progress-every", "0"], "--progress-every"),
+])
+def test_sweep_backend_options_checked_before_work(tmp_path, capsys, argv, word):
+    out = tmp_path / "s"
+    assert main(["sweep", "--g0", "10", "--theta0", "30", "--out", str(out), *argv]) == 2
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1 and word in err, err
+    assert not (out / "_sweep.json").exists()
+
+
+def test_dask_is_imported_only_when_used():
+    code = ("import sys, loopsim.cli, loopsim.ensemble; "
+            "print(any(m.split('.')[0] in ('dask', 'distributed') for m in sys.modules))")
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                            check=True)
+    assert result.stdout.strip() == "False"
