@@ -147,6 +147,7 @@ def simulate(
     max_steps=DEFAULT_MAX_STEPS, length_tol=DEFAULT_LENGTH_TOL, first_step=None,
     max_step=math.inf, min_step=0.0, steady_tol=None, steady_interval=DEFAULT_STEADY_INTERVAL,
     initial=None, initial_case_id=None, n_max=DEFAULT_N_MAX, tail_tol=DEFAULT_TAIL_TOL,
+    n_start=None,
 ):
     """Simulate a loop released as a perturbed circle tilted by ``theta0_deg``.
 
@@ -158,8 +159,8 @@ def simulate(
     steady terminal state (``integrators.step_options``).  ``g0`` is gravity
     over stiffness, ``w`` the length-penalty rate, ``perturbation`` the RMS
     size of the seeded initial perturbation (``shapes.circle``; default 1e-3,
-    n = 6).  ``n="auto"`` starts at n = 6 (or a given shape's order) and raises n
-    up to ``n_max`` whenever the spectral tail passes ``tail_tol``
+    n = 6).  ``n="auto"`` starts at ``n_start`` (default 6, or a given shape's
+    order) and raises n up to ``n_max`` whenever the spectral tail passes ``tail_tol``
     (``loopsim.refinement``).  ``method="auto"`` picks the integrator for the case
     (``refinement.auto_method``).
 
@@ -176,9 +177,13 @@ def simulate(
     if refine:
         validation.check_choice("n", n, ("auto",))
         tail_tol = validation.check_real("tail_tol", tail_tol, low=0.0, low_open=True)
+    if refine:
+        n = n_start if n_start is not None else (
+            refinement.AUTO_START if initial is None else None)
+    elif n_start is not None:
+        raise ValueError("n_start applies only with n='auto'")
     x0, theta0_deg, n, perturbation, initial_info = shapes.start_shape(
-        theta0_deg, refinement.AUTO_START if refine and initial is None else
-        (None if refine else n), perturbation, seed, initial, initial_case_id)
+        theta0_deg, n, perturbation, seed, initial, initial_case_id)
     ladder = refinement.orders(n, max(n, validation.check_integer("n_max", n_max, 1))) \
         if refine else (n,)
     if method == "auto":

@@ -296,13 +296,13 @@ def _traced_case(config, case_id):
     so they agree exactly (its steps land on the snapshot times)."""
     case = config.cases[case_id]
     method = case_method(config, case)
+    start = dict(_start(case), **({"n": "auto", "n_start": case["n"]} if config.n_auto else {}))
     result = api.simulate(
-        case["g0"], **_start(case), t_span=(0.0, config.t_end),
+        case["g0"], **start, t_span=(0.0, config.t_end),
         snapshots=config.snapshot_count, rtol=config.rtol, atol=config.atol, w=config.w,
         method=method, max_steps=config.max_steps, length_tol=config.length_tol,
         steady_tol=config.steady_tol if config.early_stop else None,
-        steady_interval=config.steady_interval, n_max=config.n_max, tail_tol=config.tail_tol,
-        **({"n": "auto"} if config.n_auto else {}))
+        steady_interval=config.steady_interval, n_max=config.n_max, tail_tol=config.tail_tol)
     x0 = shapes.start_shape(**_start(case))[0]
     row = _result_row(config, case_id, case, x0, result.x_final, result.status_code,
                       [getattr(result, name) for name in integrators.COUNTS],

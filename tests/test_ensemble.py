@@ -43,12 +43,14 @@ def test_classification_thresholds_are_parameters():
 
 
 def test_resolved_flag_follows_both_thresholds():
-    """A case is resolved only with a small transient length error AND a small terminal
-    spectral tail (the two failure modes of scripts/resolution_study.py)."""
+    """A case is resolved only with a small transient length error AND a small spectral
+    tail along the run (the failure modes of scripts/resolution_study.py and
+    scripts/auto_study.py)."""
     t = ensemble.Thresholds()
     assert t.resolved(2e-7, 1e-8)
     assert not t.resolved(1.5e-4, 1e-8)  # 3D at n = 6: length error, tiny tail
     assert not t.resolved(2e-7, 1.2e-3)  # in-plane at n = 6: tail, no length error
+    assert not t.resolved(1.7e-7, 3.2e-5)  # 3D at n = 16 (150, 45°): 5° off in tilt
     assert ensemble.Thresholds(resolved_length_error=1e-3).resolved(1.5e-4, 1e-8)
 
 
@@ -193,6 +195,32 @@ def test_snapshots_do_not_change_the_results(tmp_path):
     assert plain.loc[1, "regime"] == "3d"
     snaps = loopsim.read_snapshots(str(tmp_path / "b"))
     assert len(snaps) == 2 * 31
+
+
+def test_auto_sweep_records_orders_and_methods_and_is_reproducible(tmp_path):
+    """--n auto --method auto: rows carry n (the start), n_used, tail_max and method; the
+    table is bit-identical on 1 and 2 threads and with snapshots (dense output, and the
+    traced case climbs the same ladder)."""
+    cases = ensemble.grid_cases([30.0, 150.0], [60.0], [6], seeds=1)
+    config = dict(cases=cases, t_end=0.4, method="auto", n_auto=True, n_max=12)
+    one = ensemble.run_sweep(ensemble.SweepConfig(**config), str(tmp_path / "a"), threads=1,
+                             quiet=True)
+    two = ensemble.run_sweep(ensemble.SweepConfig(**config), str(tmp_path / "b"), threads=2,
+                             quiet=True)
+    numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
+    traced = ensemble.run_sweep(ensemble.SweepConfig(**config, snapshots_for=[1],
+                                                     snapshot_count=5),
+                                str(tmp_path / "c"), quiet=True)
+    columns = DETERMINISTIC + ["n_used", "tail_max", "method"]
+    pd.testing.assert_frame_equal(one[columns], two[columns], check_exact=True)
+    physics = [c for c in columns if c not in ("nfev", "njev", "nlu")]
+    pd.testing.assert_frame_equal(one[physics], traced[physics], check_exact=True)
+    assert list(one["n"]) == [6, 6] and list(one["method"]) == ["radau5", "radau5"]
+    assert one.loc[1, "n_used"] > 6  # the 3D case climbs
+    for _, row in one.iterrows():
+        assert len(row["x_final"]) == 3 * (2 * row["n_used"] + 1)
+    snaps = loopsim.read_snapshots(str(tmp_path / "c"))
+    assert {len(x) for x in snaps["x"]} == {3 * (2 * one.loc[1, "n_used"] + 1)}
 
 
 def test_snapshots_for_unknown_case_is_refused(tmp_path, capsys):
