@@ -4,10 +4,12 @@ Errors in the input end with one line ``loopsim: error: ...`` on stderr and
 exit status 2; a run that fails numerically exits 1 after printing its summary.
 """
 import argparse
+import contextlib
 import json
 import math
 import os
 import sys
+import warnings
 
 from ._version import __version__
 from .config import (
@@ -107,7 +109,7 @@ def _build_parser():
                      help="initial tilt of the loop's plane to the horizontal, in [0, 90] degrees "
                      "(not with --initial: the tilt is measured)")
     run.add_argument("--n", type=_order, default=None,
-                     help=f"Fourier truncation order (>= 1; default {DEFAULT_N}, or the stored "
+                     help=f"Fourier truncation order (1..128; default {DEFAULT_N}, or the stored "
                      "order of --initial results), or auto: start there and raise n during "
                      "the run whenever the spectral tail passes --tail-tol")
     run.add_argument("--initial", metavar="FILE|DIR",
@@ -284,11 +286,33 @@ def _format_initial(info):
         for k in keys if k in info])
 
 
+def _check_run_sizes(args):
+    """--n, --n-max and --snapshots within their documented bounds, before any work."""
+    from . import validation
+
+    if args.n not in (None, "auto"):
+        validation.check_order("--n", args.n)
+    validation.check_order("--n-max", args.n_max)
+    validation.check_count("--snapshots", args.snapshots, 1, validation.MAX_SNAPSHOTS,
+                           "each is a step end and a stored state")
+
+
 def _cmd_run(args):
+    try:
+        return _run(args)
+    except KeyboardInterrupt:  # a Ctrl-C while loading, before the integration's handler
+        return _interrupted(2, "the run was stopped; nothing written")
+
+
+def _run(args):
+    import functools
+
     from . import api, ensemble, io, validation
 
+    _check_run_sizes(args)
     if args.out is not None:
         validation.check_output_file("--out", args.out)
+        io.remove_stale_temporaries(os.path.dirname(os.path.abspath(args.out)))
     g0, start, info = args.g0, None, None
     if args.initial is not None:
         start, info, g0 = _load_initial_for_run(args)
@@ -296,36 +320,60 @@ def _cmd_run(args):
         raise ValueError("--case-id needs --initial RESULTS")
     elif args.theta0 is None or args.g0 is None:
         raise ValueError(f"give {'--g0' if args.g0 is None else '--theta0'} (or --initial FILE)")
-    result = api.simulate(
-        g0, args.theta0, n=args.n, t_span=(0.0, args.t_end), snapshots=args.snapshots,
-        rtol=args.rtol, atol=args.atol, w=args.w, perturbation=args.perturbation,
-        seed=args.seed, method=args.method, initial=start, n_max=args.n_max,
-        tail_tol=args.tail_tol,
-    )
-    summary = result.summary()
-    if info is not None:
-        info = dict(info, perturbation=summary["perturbation"])
-        result.initial_info = info
-        for warning in info["warnings"]:
-            print(f"loopsim: warning: {warning}", file=sys.stderr)
-    if not ensemble.Thresholds().resolved(result.length_error_max, result.tail_max):
-        print(f"loopsim: warning: not resolved at n = {summary['n_used']} (length error up to "
-              f"{result.length_error_max:.2g}, limit {RESOLVED_LENGTH_ERROR:g}; spectral tail up "
-              f"to {result.tail_max:.2g}, limit {RESOLVED_TAIL:g}): the terminal tilt and shape "
-              "are not converged; increase --n or use --n auto", file=sys.stderr)
-    if args.out and info is None:
-        io.write_trajectory(result, args.out, command_line=sys.argv)
-    elif args.out:  # the initial shape's diagnostics (scale, source) as metadata "initial"
-        table = io.trajectory_table(result, command_line=sys.argv)
-        meta = dict(table.schema.metadata or {})
-        meta[b"initial"] = json.dumps(info).encode()
-        io.write_table_atomically(table.replace_schema_metadata(meta), args.out)
+    simulate = functools.partial(
+        api.simulate, g0, args.theta0, n=args.n, t_span=(0.0, args.t_end),
+        snapshots=args.snapshots, rtol=args.rtol, atol=args.atol, w=args.w,
+        perturbation=args.perturbation, seed=args.seed, method=args.method, initial=start,
+        n_max=args.n_max, tail_tol=args.tail_tol)
+    stop = ensemble.stop_event()
+    with ensemble.stop_on_signals(stop):  # the integration in a thread, a signal noticed
+        result = ensemble.in_background(stop, simulate)  # within 0.1 s (see _interrupted)
+        if result is None:
+            return _interrupted(stop.signum, "the run was stopped; nothing written")
+        summary = result.summary()
+        if info is not None:
+            info = dict(info, perturbation=summary["perturbation"])
+            result.initial_info = info
+            for warning in info["warnings"]:
+                print(f"loopsim: warning: {warning}", file=sys.stderr)
+        if not ensemble.Thresholds().resolved(result.length_error_max, result.tail_max):
+            print(f"loopsim: warning: not resolved at n = {summary['n_used']} (length error up "
+                  f"to {result.length_error_max:.2g}, limit {RESOLVED_LENGTH_ERROR:g}; spectral "
+                  f"tail up to {result.tail_max:.2g}, limit {RESOLVED_TAIL:g}): the terminal "
+                  "tilt and shape are not converged; increase --n or use --n auto",
+                  file=sys.stderr)
+        if args.out:  # a signal now waits for the (atomic) write to finish
+            table = io.trajectory_table(result, command_line=sys.argv)
+            if info is not None:  # the initial shape's diagnostics (scale, source)
+                meta = dict(table.schema.metadata or {})
+                meta[b"initial"] = json.dumps(info).encode()
+                table = table.replace_schema_metadata(meta)
+            io.write_table_atomically(table, args.out)
     if args.json:
         print(json.dumps(summary if info is None else dict(summary, initial=info)))
     else:
         print(_format_summary(summary) if info is None
               else _format_initial(info) + "\n" + _format_summary(summary))
+    if stop.is_set():
+        return _interrupted(stop.signum, "after the run finished; its results are complete"
+                            + (f" in {args.out}" if args.out else ""))
     return 0 if result.success else EXIT_FAILED_RUN
+
+
+def _interrupted(signum, detail):
+    """The one way a command ends on SIGINT / SIGTERM: one line on stderr, no traceback,
+    exit status 128 + signum (130 / 143).  As the ``loopsim`` program it exits at once
+    (``os._exit``: a kernel may still run in a worker thread and cannot be cut short)."""
+    import signal
+
+    signum = signum or signal.SIGINT
+    print(f"loopsim: interrupted by {signal.Signals(signum).name}: {detail}", file=sys.stderr)
+    status = 128 + int(signum)
+    if _is_program():
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(status)
+    return status
 
 
 RERUN_OPTIONS = ("method", "rtol", "atol")  # what --rerun-failed takes from the command line
@@ -343,6 +391,8 @@ def _parse_shard(text):
 
 
 def _sweep_config(args, ensemble):
+    from . import validation
+
     if args.cases:
         if args.g0 or args.theta0:
             raise ValueError("give either --cases or --g0/--theta0, not both")
@@ -354,10 +404,15 @@ def _sweep_config(args, ensemble):
             raise ValueError("a sweep needs --g0 and --theta0 (or --cases FILE)")
         if args.seeds < 1:
             raise ValueError(f"--seeds must be >= 1, got {args.seeds}")
-        cases = ensemble.grid_cases(
-            ensemble.parse_values(args.g0, "--g0"), ensemble.parse_values(args.theta0, "--theta0"),
-            [DEFAULT_N] if args.n == "auto" else ensemble.parse_values(args.n, "--n", integer=True),
-            args.seeds, args.perturbation)
+        axes = (ensemble.parse_values(args.g0, "--g0"),
+                ensemble.parse_values(args.theta0, "--theta0"),
+                [DEFAULT_N] if args.n == "auto"
+                else ensemble.parse_values(args.n, "--n", integer=True))
+        count = math.prod(len(axis) for axis in axes) * args.seeds
+        if count > validation.MAX_CASES:
+            raise ValueError(f"the grid has {count} cases (--g0 x --theta0 x --n x --seeds), "
+                             f"more than a sweep's {validation.MAX_CASES}: split it")
+        cases = ensemble.grid_cases(*axes, args.seeds, args.perturbation)
     return ensemble.SweepConfig(cases=cases, t_end=args.t_end, rtol=args.rtol, atol=args.atol,
                                 w=args.w, method=args.method, chunk_size=args.chunk_size,
                                 early_stop=not args.no_early_stop,
@@ -421,33 +476,25 @@ def _cmd_sweep(args):
         else:
             if args.out is None:
                 raise ValueError("a sweep needs --out DIR (or --rerun-failed DIR)")
-            out = args.out
+            out = validation.check_output_directory("--out", args.out)
             config = _sweep_config(args, ensemble)
             frame = ensemble.run_sweep(config, out, shard=None if args.shard is None
                                        else _parse_shard(args.shard), **backend)
     except KeyboardInterrupt as stopped:  # ensemble.SweepInterrupted, or a Ctrl-C before it
-        signum = getattr(stopped, "signum", 2)
-        name = "SIGINT" if signum == 2 else "SIGTERM"
-        done = (f": {stopped.done} of {stopped.total} cases done and kept in "
-                f"{stopped.out}" if hasattr(stopped, "done") else "")
-        print(f"loopsim: interrupted by {name}{done}; re-run the same command to resume",
-              file=sys.stderr)
-        status = getattr(stopped, "exit_status", 130)
-        if _is_program():  # a kernel may still run in a thread: no seconds-long teardown
-            sys.stdout.flush()
-            sys.stderr.flush()
-            os._exit(status)
-        return status
+        done = (f"{stopped.done} of {stopped.total} cases done and kept in {stopped.out}; "
+                if hasattr(stopped, "done") else "")
+        return _interrupted(getattr(stopped, "signum", 2),
+                            f"{done}re-run the same command to resume")
     counts = frame["regime"].value_counts().to_dict()
     print(f"{len(frame)} cases in {out}: "
           + ", ".join(f"{k} {v}" for k, v in sorted(counts.items())))
     unresolved = frame[~frame["resolved"]]
     if len(unresolved):
         print(f"{len(unresolved)} of {len(frame)} cases NOT resolved at their n (transient length "
-              f"error > {config.thresholds.resolved_length_error:g} or terminal spectral tail > "
-              f"{config.thresholds.resolved_tail:g}; column 'resolved'): their "
-              f"terminal tilt and shape are not converged; rerun them with a larger --n "
-              f"(regimes among them: " + ", ".join(
+              f"error > {config.thresholds.resolved_length_error:g} or spectral tail along the "
+              f"run > {config.thresholds.resolved_tail:g}; column 'resolved'): their "
+              f"terminal tilt and shape are not converged; rerun them with a larger --n or "
+              f"--n auto (regimes among them: " + ", ".join(
                   f"{k} {v}" for k, v in sorted(unresolved["regime"].value_counts().items())) + ")")
     if args.figure:
         _use_agg()
@@ -477,8 +524,9 @@ def _cmd_stability_full(args):
     for key, value in FULL_DEFAULTS.items():
         if getattr(args, key) is None:
             setattr(args, key, value)
-    if args.n < 3:
-        raise ValueError(f"--n must be >= 3 for the full linearisation, got {args.n}")
+    if not 3 <= args.n <= validation.MAX_N:
+        raise ValueError(f"--n must be in 3..{validation.MAX_N} for the full linearisation, "
+                         f"got {args.n}")
     if not 0.0 < args.theta0 <= 90.0:
         raise ValueError(f"--theta0 must be in (0, 90], got {args.theta0}")
     if args.w <= 0.0:
@@ -546,6 +594,7 @@ def _cmd_stability_full(args):
 
 def _cmd_stability(args):
     from .stability import paper
+    from .validation import MAX_N
 
     if not args.paper:
         return _cmd_stability_full(args)
@@ -554,8 +603,8 @@ def _cmd_stability(args):
         raise ValueError(f"--{given[0].replace('_', '-')} applies only to the full linearisation "
                          "(drop --paper)")
     n_max = 60 if args.n_max is None else args.n_max
-    if n_max < 1:
-        raise ValueError(f"--n-max must be >= 1, got {n_max}")
+    if not 1 <= n_max <= MAX_N:  # the table to 128 took 2.5 s; 100 000 never ended
+        raise ValueError(f"--n-max must be in 1..{MAX_N}, got {n_max}")
     table = paper.critical_q_table(n_max)
     if args.json:
         print(json.dumps({"operator": "paper", "note": paper.SIGN_NOTE, "critical_q": {
@@ -619,13 +668,24 @@ def _use_agg():
     matplotlib.use("Agg")
 
 
+@contextlib.contextmanager
+def _one_line_warnings():
+    """Warnings (a damaged file moved aside, a stray copy ignored) as one line each:
+    ``loopsim: warning: ...``, without Python's source line."""
+    with warnings.catch_warnings():
+        warnings.showwarning = lambda message, *_, **__: print(
+            f"loopsim: warning: {message}", file=sys.stderr)
+        yield
+
+
 def main(argv=None):
     parser = _build_parser()
     args = parser.parse_args(argv)
     handlers = {"run": _cmd_run, "sweep": _cmd_sweep, "stability": _cmd_stability,
                 "branch": _cmd_branch, "figures": _cmd_figures}
     try:
-        return handlers[args.command](args)
+        with _one_line_warnings():
+            return handlers[args.command](args)
     except (ValueError, OSError) as exc:
         print(f"loopsim: error: {exc}", file=sys.stderr)
         return EXIT_USAGE

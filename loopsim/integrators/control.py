@@ -35,7 +35,7 @@ STATUS_NAMES = {
     NON_FINITE: "non-finite state",
     LENGTH_ERROR: "length error too large",
     STEADY: "ok",
-    REFINE: "not resolved at the highest truncation",
+    REFINE: "truncation outgrown (resolution_tol passed)",
 }
 #: Why a run stopped, per status.
 STOP_REASONS = {**STATUS_NAMES, OK: "t_end", STEADY: "steady"}
