@@ -95,22 +95,29 @@ FIELD_NOTES = {
 
 # ---- configuration -------------------------------------------------------
 def parse_values(text, name, integer=False):
-    """'START:STOP:NUM' (linspace, ends included) or 'v1,v2,...' -> list of numbers."""
+    """'START:STOP:NUM' (linspace, ends included) or 'v1,v2,...' -> list of numbers; NUM at
+    most ``validation.MAX_CASES`` (checked before anything is built)."""
     convert = int if integer else float
+    num = None
     try:
         if ":" in text:
             start, stop, num = text.split(":")
             num = int(num)
             if num < 1:
                 raise ValueError
-            values = np.linspace(float(start), float(stop), num).tolist()
+            if num <= validation.MAX_CASES:
+                values = np.linspace(float(start), float(stop), num).tolist()
         else:
             values = [convert(v) for v in text.split(",") if v.strip()]
-        if not values or not all(math.isfinite(v) for v in values):
-            raise ValueError
+        if num is None or num <= validation.MAX_CASES:
+            if not values or not all(math.isfinite(v) for v in values):
+                raise ValueError
     except ValueError:
         form = "v1,v2,..." if integer else "START:STOP:NUM or v1,v2,..."
         raise ValueError(f"{name} must be {form}, got {text!r}") from None
+    if num is not None and num > validation.MAX_CASES:
+        raise ValueError(f"{name} asks for {num} values, more than a sweep's "
+                         f"{validation.MAX_CASES} cases: {text!r}")
     return [convert(v) for v in values]
 
 
@@ -186,10 +193,22 @@ def _case_row(path, i, row):
 
 def read_cases_file(path, perturbation=DEFAULT_PERTURBATION, n=6):
     """Cases from a CSV or Parquet table: columns g0, theta0_deg (required), n, seed, perturbation."""
+    validation.check_input_file("cases file", path, validation.MAX_CASES_FILE_BYTES)
+    limit = validation.MAX_CASES
     try:
-        frame = pd.read_parquet(path) if str(path).endswith(".parquet") else pd.read_csv(path)
+        if str(path).endswith(".parquet"):
+            import pyarrow.parquet as pq
+
+            rows = pq.ParquetFile(path).metadata.num_rows
+            frame = None if rows > limit else pd.read_parquet(path)
+        else:
+            frame = pd.read_csv(path, nrows=limit + 1)
+            rows = len(frame)
     except Exception as exc:  # noqa: BLE001 - any reader failure is the same user error
         raise ValueError(f"cannot read cases file {path!r}: {exc}".splitlines()[0]) from None
+    if rows > limit:
+        raise ValueError(f"cases file {path!r} has more than {limit} rows (a sweep's most "
+                         "cases)")
     missing = {"g0"} | ({"theta0_deg"} if "initial" not in frame.columns else set())
     missing -= set(frame.columns)
     if missing:
@@ -216,11 +235,14 @@ def validate(config):
     """One-line ValueError naming the first bad value."""
     if not config.cases:
         raise ValueError("the sweep has no cases")
+    if len(config.cases) > validation.MAX_CASES:
+        raise ValueError(f"the sweep has {len(config.cases)} cases, more than "
+                         f"{validation.MAX_CASES}: split it into several sweeps")
     for case_id, case in enumerate(config.cases):
         try:
             validation.check_real("g0", case["g0"], low=0.0)
             validation.check_tilt("theta0_deg", case["theta0_deg"])
-            validation.check_integer("n", case["n"], 1)
+            validation.check_order("n", case["n"])
             validation.check_integer("seed", case["seed"], 0)
             validation.check_real("perturbation", case["perturbation"], low=0.0)
         except ValueError as exc:
@@ -230,13 +252,14 @@ def validate(config):
     validation.check_real("atol", config.atol, low=0.0)
     validation.check_real("w", config.w, low=0.0)
     validation.check_integer("chunk_size", config.chunk_size, 1)
-    validation.check_integer("snapshot_count", config.snapshot_count, 2)
+    validation.check_count("snapshot_count", config.snapshot_count, 2, validation.MAX_SNAPSHOTS,
+                           "each is a step end and a stored state")
     for case_id in config.snapshots_for:
         if not 0 <= case_id < len(config.cases):
             raise ValueError(f"--snapshots-for names case {case_id}, but the sweep has cases "
                              f"0..{len(config.cases) - 1}")
     validation.check_choice("method", config.method, refinement.METHOD_CHOICES)
-    validation.check_integer("n_max", config.n_max, 1)
+    validation.check_order("n_max", config.n_max)
     validation.check_real("tail_tol", config.tail_tol, low=0.0, low_open=True)
 
 
@@ -549,6 +572,18 @@ def _in_background(stop, function, *args):
     return box["result"]
 
 
+def stop_event():
+    """A stop flag for :func:`stop_on_signals`: a threading.Event with ``signum`` None."""
+    stop = threading.Event()
+    stop.signum = None
+    return stop
+
+
+#: The one signal handling of every command that runs kernels (sweeps and ``loopsim run``).
+stop_on_signals = _stop_on_signals
+in_background = _in_background
+
+
 # ---- the sweep directory -----------------------------------------------------------------
 def _prepare_directory(out, config, command_line):
     """Create or check ``out`` and return the configuration's fingerprint.  A directory
@@ -568,17 +603,36 @@ def _prepare_directory(out, config, command_line):
         raise ValueError(f"{out!r} holds a different sweep (differs in: "
                          f"{', '.join(changed) or 'its fingerprint'}); use another --out")
     files = io.chunk_files(out)
+    repair_directory(out, files, stored)
+    files = io.chunk_files(out)
     io.check_files_belong(dict(config=current, fingerprint=fingerprint), files)
     _remove_contained(out, files, len(config.cases))
     io.check_no_overlap(io.chunk_files(out))
     io.remove_stale_temporaries(out)
     io.remove_stale_temporaries(os.path.join(out, io.SNAPSHOT_DIR))
     if stored is None:
+        hashed = all(io.CONTENT_KEY in io.read_metadata(path) for path in files.values())
         io.write_json_atomically(dict(
             layout=io.LAYOUT, fingerprint=fingerprint, config=current, command_line=command_line,
-            field_notes=FIELD_NOTES, reruns=[], **json.loads(json.dumps(io.provenance()))),
+            field_notes=FIELD_NOTES, reruns=[],
+            **({"checksums": io.CONTENT_KEY} if hashed else {}),
+            **json.loads(json.dumps(io.provenance()))),
             os.path.join(out, io.SWEEP_FILE))
     return fingerprint
+
+
+def repair_directory(out, files, stored):
+    """Self-repair before a resume: every result file (and its snapshot file) is read back
+    whole and checked (readable, Parquet page checksums, content hash); a damaged one is
+    moved to ``out/_quarantine/`` with a one-line warning, so its cases are computed
+    again.  Returns the number of files moved."""
+    moved = 0
+    for _, path, reason in io.damaged_files(out, files, stored):
+        snapshot = os.path.join(out, io.SNAPSHOT_DIR, os.path.basename(path))
+        if os.path.exists(snapshot):
+            io.quarantine(out, snapshot, reason)
+        moved += io.quarantine(out, path, reason)
+    return moved
 
 
 def _remove_contained(out, files, count):
@@ -729,8 +783,7 @@ def run_sweep(config, out, threads=None, quiet=False, command_line=None, *, sche
     done = set(_covered_ids(config, covered)) & set(mine)
     progress = Progress({i: case_weight(config.cases[i]) for i in mine}, done, quiet, stream,
                         progress_interval)
-    stop = threading.Event()
-    stop.signum = None
+    stop = stop_event()
     with _stop_on_signals(stop):
         if distributed and pieces:
             workers = workers or max(1, numba.config.NUMBA_NUM_THREADS // (threads or 1))
@@ -824,7 +877,8 @@ def _merge_rerun(out, fingerprint, directory, attempt, rows):
         meta = io.read_metadata(path)
         if attempt in meta.get("reruns", []):
             continue
-        table = pq.read_table(path, schema=io.RESULT_SCHEMA)
+        table = io.result_table(io.read_table_checked(path, io.requires_hash(
+            io.read_sweep_file(out))))
         mask = [i in by_id for i in table.column("case_id").to_pylist()]
         if not any(mask):
             continue

@@ -201,7 +201,9 @@ def read_sweep_file(directory):
         with open(path) as handle:
             stored = json.load(handle)
         stored["fingerprint"], stored["config"]  # noqa: B018 - both must be there
-    except (ValueError, KeyError, TypeError) as exc:
+        if config_fingerprint(stored["config"]) != stored["fingerprint"]:
+            raise ValueError("its configuration does not match its fingerprint")
+    except (ValueError, KeyError, TypeError, AttributeError) as exc:
         raise ValueError(f"{path!r} is damaged ({type(exc).__name__}: {exc}); move it away and "
                          "re-run the sweep's command to rewrite it") from None
     return stored
@@ -243,16 +245,120 @@ def write_json_atomically(data, path):
 
 
 def write_table_atomically(table, path):
-    """Write to a temporary file in the target directory, then rename into place."""
+    """Write to a temporary file in the target directory, then rename into place; with
+    Parquet page checksums (CRC32) and :data:`CONTENT_KEY`, a SHA-256 of the content and
+    metadata (:func:`content_hash`), in the file's metadata."""
+    meta = {_text(k): _text(v) for k, v in (table.schema.metadata or {}).items()
+            if _text(k) != CONTENT_KEY}
+    table = table.replace_schema_metadata(dict(meta, **{CONTENT_KEY: content_hash(table, meta)}))
     fd, tmp = _temporary(os.path.dirname(os.path.abspath(path)), ".parquet")
     os.close(fd)
     try:
-        pq.write_table(table, tmp)
+        pq.write_table(table, tmp, write_page_checksum=True)
         os.replace(tmp, path)
     except BaseException:
         if os.path.exists(tmp):
             os.remove(tmp)
         raise
+
+
+# ---- checksums: detecting damaged files -------------------------------------------------
+#: Metadata key of a file's content hash (SHA-256, hex) written by write_table_atomically.
+CONTENT_KEY = "content_sha256"
+#: Where a sweep moves damaged result files (and their snapshots) before recomputing them.
+QUARANTINE_DIR = "_quarantine"
+
+
+def _text(value):
+    return value.decode() if isinstance(value, bytes) else str(value)
+
+
+def _hash_array(digest, array):
+    """Feed one array's values (not its buffers' layout: chunking, offsets, a list's fixed
+    or variable size do not count) into ``digest``."""
+    digest.update(f"|{len(array)}:{array.null_count}|".encode())
+    if array.null_count:
+        digest.update(np.asarray(array.is_null().to_numpy(zero_copy_only=False)).tobytes())
+    kind = array.type
+    if pa.types.is_fixed_size_list(kind):
+        digest.update(np.full(len(array), kind.list_size, np.int64).tobytes())
+        _hash_array(digest, array.flatten())
+    elif pa.types.is_list(kind) or pa.types.is_large_list(kind):
+        digest.update(array.value_lengths().fill_null(0).to_numpy(zero_copy_only=False)
+                      .astype(np.int64).tobytes())
+        _hash_array(digest, array.flatten())
+    elif pa.types.is_boolean(kind):
+        digest.update(array.fill_null(False).to_numpy(zero_copy_only=False)
+                      .astype(np.uint8).tobytes())
+    elif pa.types.is_integer(kind) or pa.types.is_floating(kind):
+        digest.update(array.fill_null(0).to_numpy(zero_copy_only=False).tobytes())
+    else:  # strings and anything else: their values as JSON
+        digest.update(json.dumps(array.to_pylist(), default=str).encode())
+
+
+def content_hash(table, metadata):
+    """SHA-256 (hex) of a table's column names and values and of its schema metadata
+    ``metadata`` (a dict, without :data:`CONTENT_KEY` and pyarrow's own ``ARROW:`` keys):
+    written into every file loopsim writes, checked by :func:`read_table_checked`."""
+    digest = hashlib.sha256()
+    for key in sorted(metadata):
+        if key != CONTENT_KEY and not key.startswith("ARROW:"):
+            digest.update(f"{key}\0{metadata[key]}\0".encode())
+    for name, column in zip(table.column_names, table.columns):
+        digest.update(f"\0column {name}\0".encode())
+        _hash_array(digest, column.combine_chunks())
+    return digest.hexdigest()
+
+
+class DamagedFile(ValueError):
+    """A file that cannot be read back as written: unreadable (truncated, zero length, not
+    Parquet), a page checksum that fails, or a content hash that does not match."""
+
+    def __init__(self, path, reason):
+        super().__init__(f"{path!r} is damaged ({reason})")
+        self.path, self.reason = path, reason
+
+
+def read_table_checked(path, require_hash=False):
+    """The whole table of a Parquet file, its page checksums (where written) and its
+    content hash (:data:`CONTENT_KEY`, where present; always with ``require_hash``)
+    verified.  :class:`DamagedFile` if any fails; OSError where the file cannot be opened."""
+    try:
+        table = pq.read_table(path, page_checksum_verification=True)
+    except (FileNotFoundError, PermissionError, IsADirectoryError):
+        raise
+    except Exception as exc:  # noqa: BLE001 - whatever the reader says, the file is damaged
+        lines = str(exc).strip().splitlines()
+        raise DamagedFile(path, f"unreadable: {lines[0] if lines else type(exc).__name__}") \
+            from None
+    meta = {_text(k): _text(v) for k, v in (table.schema.metadata or {}).items()}
+    stored = meta.get(CONTENT_KEY)
+    if stored is None:
+        if require_hash:
+            raise DamagedFile(path, f"no {CONTENT_KEY} in its metadata")
+        return table
+    if content_hash(table, meta) != stored:
+        raise DamagedFile(path, "content does not match its checksum")
+    return table
+
+
+def quarantine(directory, path, reason):
+    """Move a damaged file into ``directory/_quarantine/`` (never deleted: a user may want
+    it) and warn in one line; False when it is gone already (moved by a twin sweep)."""
+    target_dir = os.path.join(directory, QUARANTINE_DIR)
+    os.makedirs(target_dir, exist_ok=True)
+    stamp = datetime.datetime.now(datetime.timezone.utc).strftime("%Y%m%dT%H%M%S")
+    name = os.path.relpath(path, directory).replace(os.sep, "-")  # _snapshots-chunk-...
+    target = os.path.join(target_dir, f"{name}.{stamp}-{os.getpid()}")
+    while os.path.exists(target):
+        target += "+"
+    try:
+        os.replace(path, target)
+    except FileNotFoundError:
+        return False
+    warnings.warn(f"{path!r} is damaged ({reason}): moved to {target!r}; its cases are "
+                  "recomputed", stacklevel=2)
+    return True
 
 
 def trajectory_table(result, command_line=None):
@@ -304,7 +410,12 @@ def read_snapshots(out):
     paths = [p for key, p in sorted(chunk_files(out, "snapshots").items()) if key in finished]
     if not paths:
         return pd.DataFrame()
-    frame = pa.concat_tables([pq.read_table(p) for p in paths]).to_pandas()
+    try:
+        tables = [read_table_checked(p) for p in paths]
+    except DamagedFile as exc:
+        raise ValueError(f"{exc}; re-run the sweep's command: it moves the file to "
+                         f"{QUARANTINE_DIR}/ and recomputes its cases") from None
+    frame = pa.concat_tables([t.replace_schema_metadata(None) for t in tables]).to_pandas()
     return frame.sort_values(["case_id", "t"], kind="stable").reset_index(drop=True)
 
 
@@ -333,10 +444,45 @@ def check_no_overlap(files):
                          "one of them away")
 
 
+def requires_hash(stored):
+    """Whether the result files of a sweep (its decoded ``_sweep.json``) must carry a
+    content hash: those of sweeps begun since checksums exist (``"checksums"`` in it)."""
+    return bool(stored) and stored.get("checksums") == CONTENT_KEY
+
+
+def result_table(table):
+    """A verified result file's table in RESULT_SCHEMA (metadata dropped)."""
+    table = table.replace_schema_metadata(None)
+    if not table.schema.equals(RESULT_SCHEMA):
+        table = table.select(RESULT_SCHEMA.names).cast(RESULT_SCHEMA)
+    return table
+
+
+def damaged_files(out, files, stored):
+    """[(key, path, reason)] of the result files ``files`` ({(start, stop): path}) of sweep
+    directory ``out`` that are damaged, or whose snapshot file is (both must then be
+    recomputed).  Files gone meanwhile (a twin sweep's clean-up) are left out."""
+    found = []
+    for key, path in sorted(files.items()):
+        snapshot = os.path.join(out, SNAPSHOT_DIR, os.path.basename(path))
+        try:
+            read_table_checked(path, requires_hash(stored))
+            if os.path.exists(snapshot):
+                read_table_checked(snapshot, requires_hash(stored))
+        except DamagedFile as exc:
+            found.append((key, path, str(exc.reason) if exc.path == path
+                          else f"its snapshot file {exc.path!r}: {exc.reason}"))
+        except FileNotFoundError:
+            continue
+    return found
+
+
 def read_results(out):
     """All finished cases of a sweep directory as a DataFrame sorted by case_id.
 
-    The same rows as ``pandas.read_parquet(out)``, checked: every file must carry the
+    The same rows as ``pandas.read_parquet(out)``, checked: every file must read back
+    whole with its page checksums and content hash (:func:`read_table_checked`; a damaged
+    file is a one-line ValueError naming it: the sweep's command repairs it), carry the
     fingerprint of the configuration in ``_sweep.json``, and no case may appear twice.
     The sweep's metadata (configuration, thresholds, versions, command line, reruns)
     is in ``frame.attrs["loopsim"]``.
@@ -351,17 +497,22 @@ def read_results(out):
             return RESULT_SCHEMA.empty_table().to_pandas()
         raise ValueError(f"{out!r} has result files but no {SWEEP_FILE} (the sweep's "
                          "configuration): re-run the sweep's command to restore it")
+    tables = {}
+    for key in sorted(files):
+        try:
+            tables[key] = result_table(read_table_checked(files[key], requires_hash(stored)))
+        except DamagedFile as exc:
+            raise ValueError(f"{exc}; re-run the sweep's command: it moves the file to "
+                             f"{QUARANTINE_DIR}/ and recomputes its cases") from None
     check_files_belong(stored, files)
     check_no_overlap(files)
     paths = [files[key] for key in sorted(files)]
     if not paths:
         return RESULT_SCHEMA.empty_table().to_pandas()
-    tables = []
     for key in sorted(files):
-        tables.append(pq.read_table(files[key], schema=RESULT_SCHEMA))
-        check_rows(files[key], key, tables[-1].column("case_id").to_pylist(),
+        check_rows(files[key], key, tables[key].column("case_id").to_pylist(),
                    len(stored["config"]["cases"]))
-    table = pa.concat_tables(tables)
+    table = pa.concat_tables([tables[key] for key in sorted(files)])
     frame = table.to_pandas().sort_values("case_id", kind="stable").reset_index(drop=True)
     duplicated = frame["case_id"][frame["case_id"].duplicated()]
     if len(duplicated):

@@ -52,3 +52,80 @@ def check_output_file(name, path):
 def check_tilt(name, value, allow_zero=True):
     """A tilt in degrees: [0, 90], or (0, 90] where a tilt fixes g0 from q."""
     return check_real(name, value, low=0.0, high=90.0, low_open=not allow_zero)
+
+
+# ---- sizes: bounded before any work --------------------------------------------------------
+#: Largest truncation order accepted (--n, --n-max, a case's n, an initial shape's n).  One
+#: right-hand side costs about 0.3 s at n = 128 and 6 s at n = 256 (measured on a loaded
+#: 2-core machine, README "Limits"), and the explicit step shrinks like n^-4: beyond 128 a
+#: single run takes days.
+MAX_N = 128
+#: Most snapshots per run or traced sweep case: each is a step end, and at n = 128 they hold
+#: 3 arrays of 3 x 257 doubles, 185 MB for 10 000.
+MAX_SNAPSHOTS = 10_000
+#: Most cases per sweep (the product of the grid's axes, or a cases file's rows): setting up
+#: 900 000 cases took 75 s and 1.7 GB here, and their _sweep.json is about 95 MB.
+MAX_CASES = 1_000_000
+#: Most points of a point file: the curve fit checks every pair of segments for crossings
+#: (1 000 points took 12 s, 10 000 took 81 s here).
+MAX_POINTS = 10_000
+#: Largest file read as a point file, a cases file, or results for --initial.
+MAX_POINT_FILE_BYTES = 16 * 2**20
+MAX_CASES_FILE_BYTES = 256 * 2**20
+MAX_RESULTS_FILE_BYTES = 2**30
+
+
+def check_order(name, value):
+    """A truncation order 1 <= n <= MAX_N, as int."""
+    value = check_integer(name, value, 1)
+    if value > MAX_N:
+        raise ValueError(f"{name} must be at most {MAX_N} (one right-hand side takes about "
+                         f"0.3 s at n = 128 and the explicit step shrinks like n^-4), got {value}")
+    return value
+
+
+def check_count(name, value, low, high, why):
+    """An integer in [low, high] (``why``: the reason for the upper bound), as int."""
+    value = check_integer(name, value, low)
+    if value > high:
+        raise ValueError(f"{name} must be at most {high} ({why}), got {value}")
+    return value
+
+
+def check_input_file(name, path, max_bytes):
+    """A regular file (not a device, FIFO or directory) of at most ``max_bytes``, so that
+    reading it is bounded; one-line ValueError naming it otherwise."""
+    import stat
+
+    path = os.fspath(path)
+    try:
+        info = os.stat(path)
+    except OSError as exc:
+        raise ValueError(f"cannot read {name} {path!r}: {exc.strerror or exc}") from None
+    if not stat.S_ISREG(info.st_mode):
+        raise ValueError(f"{name} {path!r} is not a regular file")
+    if info.st_size > max_bytes:
+        raise ValueError(f"{name} {path!r} is {info.st_size / 2**20:.1f} MiB, more than the "
+                         f"{max_bytes / 2**20:.0f} MiB read")
+    return path
+
+
+def check_output_directory(name, path):
+    """A directory that exists and is writable, or can be made (its nearest existing parent
+    is a writable directory): checked before any work."""
+    path = os.fspath(path)
+    if not path.strip():
+        raise ValueError(f"{name} is empty")
+    if os.path.exists(path):
+        if not os.path.isdir(path):
+            raise ValueError(f"{name} {path!r} is not a directory")
+        if not os.access(path, os.W_OK | os.X_OK):
+            raise ValueError(f"{name} {path!r} is not writable")
+        return path
+    parent = os.path.dirname(os.path.abspath(path))
+    while not os.path.exists(parent):
+        parent = os.path.dirname(parent)
+    if not os.path.isdir(parent) or not os.access(parent, os.W_OK | os.X_OK):
+        raise ValueError(f"{name} {path!r} cannot be made: {parent!r} is not a writable "
+                         "directory")
+    return path

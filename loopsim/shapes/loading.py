@@ -52,11 +52,23 @@ def read_points(path):
     """Points (m, 3) of a CSV/Parquet point file (columns x, y, z; others ignored)."""
     import pandas as pd
 
-    path = os.fspath(path)
+    path = validation.check_input_file("initial shape file", os.fspath(path),
+                                       validation.MAX_POINT_FILE_BYTES)
+    limit = validation.MAX_POINTS
     try:
-        frame = pd.read_parquet(path) if _is_parquet(path) else pd.read_csv(path)
+        if _is_parquet(path):
+            import pyarrow.parquet as pq
+
+            rows = pq.ParquetFile(path).metadata.num_rows
+            frame = None if rows > limit else io.read_table_checked(path).to_pandas()
+        else:
+            frame = pd.read_csv(path, nrows=limit + 1)
+            rows = len(frame)
     except Exception as exc:  # noqa: BLE001 - any reader failure is the same user error
         raise ValueError(f"cannot read initial shape file {path!r}: {_first_line(exc)}") from None
+    if rows > limit:
+        raise ValueError(f"initial shape file {path!r} has more than {limit} points (the fit "
+                         "checks every pair of segments: 10 000 points take about 80 s)")
     names = {str(c).strip().lower(): c for c in frame.columns}
     missing = [c for c in POINT_COLUMNS if c not in names]
     if missing:
@@ -150,6 +162,7 @@ def _results_shape(path, case_id):
 
     if os.path.isdir(path):
         return _results_case(io.read_results(path), path, case_id)
+    validation.check_input_file("initial shape file", path, validation.MAX_RESULTS_FILE_BYTES)
     if not _is_parquet(path):
         return None
     try:
@@ -158,10 +171,10 @@ def _results_shape(path, case_id):
         raise ValueError(f"cannot read initial shape file {path!r}: {_first_line(exc)}") from None
     names = set(schema.names)
     if {"case_id", "x_final"} <= names:  # one chunk file of a sweep
-        return _results_case(pq.read_table(path).to_pandas(), path, case_id)
+        return _results_case(io.read_table_checked(path).to_pandas(), path, case_id)
     if not {"t", "x"} <= names:
         return None
-    table = pq.read_table(path, columns=[c for c in ("case_id", "t", "x") if c in names])
+    table = io.read_table_checked(path).select([c for c in ("case_id", "t", "x") if c in names])
     rows = table.to_pandas()
     if "case_id" in names:  # a sweep's snapshots file
         ids = sorted(set(rows["case_id"]))
@@ -200,7 +213,7 @@ def load_initial(path, n=None, case_id=None):
     """
     path = os.fspath(path)
     if n is not None:
-        validation.check_integer("n", n, 1)
+        validation.check_order("n", n)
     if case_id is not None:
         validation.check_integer("case id", case_id, 0)
     if not os.path.exists(path):
@@ -279,7 +292,7 @@ def start_shape(theta0_deg=None, n=None, perturbation=None, seed=0, initial=None
     the circle, else the shape's diagnostics.
     """
     if n is not None:
-        n = validation.check_integer("n", n, 1)
+        n = validation.check_order("n", n)
     perturbation = default_perturbation(initial is not None) if perturbation is None \
         else validation.check_real("perturbation", perturbation, low=0.0)
     seed = validation.check_integer("seed", seed, 0)

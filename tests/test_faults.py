@@ -1,0 +1,335 @@
+"""Fault injection (issue 14): damaged result files (truncated, zero length, a flipped bit)
+are detected, moved aside and recomputed; damaged --initial results are refused; sizes
+are bounded before any work; Ctrl-C on ``loopsim run``; temporaries of killed runs."""
+import os
+import shutil
+import signal
+import socket
+import subprocess
+import sys
+import time
+
+import numpy as np
+import pandas as pd
+import pyarrow as pa
+import pyarrow.parquet as pq
+import pytest
+
+import loopsim
+from loopsim import ensemble, io, validation
+from loopsim.cli import main
+
+DETERMINISTIC = [c for c in io.RESULT_SCHEMA.names if c != "wall_s"]
+
+
+def _config():
+    cases = ensemble.grid_cases([10.0, 60.0], [30.0], [4], seeds=1)
+    return ensemble.SweepConfig(cases=cases, t_end=0.2, chunk_size=1, snapshots_for=[1],
+                                snapshot_count=3)
+
+
+@pytest.fixture(scope="module")
+def pristine(tmp_path_factory):
+    """A 2-case sweep (one file per case, case 1 with snapshots) and its rows."""
+    out = str(tmp_path_factory.mktemp("pristine") / "s")
+    frame = ensemble.run_sweep(_config(), out, threads=1, quiet=True)
+    return out, frame
+
+
+@pytest.fixture
+def sweep(tmp_path, pristine):
+    out = str(tmp_path / "s")
+    shutil.copytree(pristine[0], out)
+    return out
+
+
+def _same_rows(a, b):
+    pd.testing.assert_frame_equal(a[DETERMINISTIC].reset_index(drop=True),
+                                  b[DETERMINISTIC].reset_index(drop=True), check_exact=True)
+
+
+def _silent_flip(path, column):
+    """Flip, in place, the first bit (bit 0 of a byte, from the start) that plain
+    ``pq.read_table`` reads without an error as other values of ``column``: silent
+    corruption before checksums.  Returns the byte offset."""
+    original = open(path, "rb").read()
+    expected = pq.read_table(path).column(column)
+    meta = pq.ParquetFile(path).metadata.row_group(0)
+    chunk = next(meta.column(i) for i in range(meta.num_columns)
+                 if meta.column(i).path_in_schema.split(".")[0] == column)
+    start = min(o for o in (chunk.dictionary_page_offset, chunk.data_page_offset) if o)
+    for offset in range(start, start + chunk.total_compressed_size):
+        data = bytearray(original)
+        data[offset] ^= 1
+        with open(path, "wb") as handle:
+            handle.write(bytes(data))
+        try:
+            changed = not pq.read_table(path).column(column).equals(expected)
+        except Exception:  # noqa: BLE001 - a flip the reader notices: not silent
+            continue
+        if changed:
+            return offset
+    raise AssertionError(f"no silent flip of {column} found in {path}")
+
+
+def _damage(path, how):
+    if how == "truncated":
+        os.truncate(path, os.path.getsize(path) // 2)
+    elif how == "zero length":
+        os.truncate(path, 0)
+    elif how == "zeroed":
+        size = os.path.getsize(path)
+        with open(path, "wb") as handle:
+            handle.write(bytes(size))
+    else:
+        _silent_flip(path, how)
+
+
+@pytest.mark.parametrize("how", ["truncated", "zero length", "zeroed", "theta_final_deg",
+                                 "case_id", "x_final"])
+def test_damaged_result_file_is_reported_then_recomputed(sweep, pristine, capsys, how):
+    """read_results names the damaged file in one line; the sweep's command moves it to
+    _quarantine/ with a one-line warning and recomputes exactly its cases."""
+    name = io.CHUNK_PATTERN.format(0, 1)
+    _damage(os.path.join(sweep, name), how)
+    with pytest.raises(ValueError) as error:
+        loopsim.read_results(sweep)
+    message = str(error.value)
+    assert name in message and "damaged" in message and "\n" not in message, message
+    argv = ["sweep", "--g0", "10,60", "--theta0", "30", "--n", "4", "--t-end", "0.2",
+            "--chunk-size", "1", "--snapshots-for", "1", "--snapshots", "3", "--quiet",
+            "--threads", "1", "--out", sweep]
+    assert main(argv) == 0
+    err = capsys.readouterr().err.splitlines()
+    assert len(err) == 1 and err[0].startswith("loopsim: warning: ") and name in err[0], err
+    assert [n.split(".parquet")[0] for n in os.listdir(os.path.join(sweep, "_quarantine"))] == [
+        name.split(".parquet")[0]]
+    _same_rows(loopsim.read_results(sweep), pristine[1])
+
+
+def test_damaged_snapshot_file_recomputes_its_piece(sweep, pristine):
+    snapshots = os.path.join(sweep, io.SNAPSHOT_DIR, io.CHUNK_PATTERN.format(1, 2))
+    _silent_flip(snapshots, "x")
+    with pytest.raises(ValueError, match="damaged"):
+        loopsim.read_snapshots(sweep)
+    with pytest.warns(UserWarning, match="snapshot file"):
+        frame = ensemble.run_sweep(_config(), sweep, threads=1, quiet=True)
+    _same_rows(frame, pristine[1])
+    pd.testing.assert_frame_equal(loopsim.read_snapshots(sweep),
+                                  loopsim.read_snapshots(pristine[0]))
+    assert len(os.listdir(os.path.join(sweep, "_quarantine"))) == 2  # result and snapshots
+
+
+def test_random_bit_flips_are_detected_or_harmless(sweep, pristine):
+    """40 random single-bit flips of one result file: each is detected or changes no value
+    that read_results returns (flips in unused statistics or padding)."""
+    path = os.path.join(sweep, io.CHUNK_PATTERN.format(1, 2))
+    original = open(path, "rb").read()
+    rng = np.random.default_rng(14)
+    outcomes = []
+    for bit in rng.choice(len(original) * 8, 40, replace=False):
+        data = bytearray(original)
+        data[bit // 8] ^= 1 << int(bit % 8)
+        with open(path, "wb") as handle:
+            handle.write(bytes(data))
+        try:
+            frame = loopsim.read_results(sweep)
+        except ValueError:
+            outcomes.append("detected")
+            continue
+        assert frame.equals(pristine[1]), f"bit {bit} changed values silently"
+        outcomes.append("harmless")
+    assert "detected" in outcomes
+
+
+def test_file_without_its_checksum_is_damaged(sweep):
+    """A result file rewritten without the content hash (or a flip that hid its key) is
+    not trusted in a sweep that writes checksums."""
+    path = os.path.join(sweep, io.CHUNK_PATTERN.format(0, 1))
+    table = pq.read_table(path)
+    meta = {k: v for k, v in table.schema.metadata.items() if k != io.CONTENT_KEY.encode()}
+    pq.write_table(table.replace_schema_metadata(meta), path)
+    with pytest.raises(ValueError, match="no content_sha256"):
+        loopsim.read_results(sweep)
+
+
+def test_page_checksums_are_written_and_verified(tmp_path):
+    """Without the content hash, the Parquet page CRCs alone catch a flipped data byte."""
+    path = str(tmp_path / "t.parquet")
+    table = pa.table({"v": np.arange(256, dtype=np.float64)})
+    io.write_table_atomically(table, path)
+    assert pq.ParquetFile(path).metadata.row_group(0).column(0).total_compressed_size > 0
+    plain = str(tmp_path / "plain.parquet")
+    pq.write_table(table, plain, write_page_checksum=True, compression="none")
+    data = bytearray(open(plain, "rb").read())
+    data[200] ^= 1  # inside the values of the only data page
+    open(plain, "wb").write(bytes(data))
+    assert not pq.read_table(plain).column("v").equals(table.column("v"))  # silent without
+    with pytest.raises(io.DamagedFile, match="unreadable"):
+        io.read_table_checked(plain)
+
+
+def test_content_hash_ignores_layout_not_values():
+    table = pa.table({"a": [1.0, 2.0, 3.0], "x": [[1.0], [2.0, 3.0], []]})
+    chunked = pa.concat_tables([table.slice(0, 1), table.slice(1)])
+    assert io.content_hash(chunked, {}) == io.content_hash(table, {})
+    changed = table.set_column(0, "a", pa.array([1.0, 2.0, 3.0000000000000004]))
+    assert io.content_hash(changed, {}) != io.content_hash(table, {})
+    assert io.content_hash(table, {"k": "v"}) != io.content_hash(table, {"k": "w"})
+
+
+def test_damaged_initial_results_are_refused(tmp_path, capsys):
+    """A flipped bit in a run file's coefficients used to change the start shape silently."""
+    run = str(tmp_path / "run.parquet")
+    assert main(["run", "--g0", "60", "--theta0", "30", "--n", "4", "--t-end", "0.05",
+                 "--out", run]) == 0
+    capsys.readouterr()
+    _silent_flip(run, "x")
+    assert main(["run", "--initial", run, "--t-end", "0.01"]) == 2
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1 and "damaged" in err and run in err, err
+
+
+def test_damaged_chunk_as_initial_is_refused(sweep, capsys):
+    path = os.path.join(sweep, io.CHUNK_PATTERN.format(1, 2))
+    _silent_flip(path, "x_final")
+    assert main(["run", "--initial", path, "--t-end", "0.01"]) == 2
+    assert "damaged" in capsys.readouterr().err
+    assert main(["run", "--initial", sweep, "--case-id", "0", "--t-end", "0.01"]) == 2
+    assert "damaged" in capsys.readouterr().err
+
+
+# ---- sizes and inputs bounded before any work --------------------------------------------
+def _point_file(path, rows):
+    s = np.linspace(0.0, 2 * np.pi, rows, endpoint=False)
+    pd.DataFrame(dict(x=np.cos(s), y=np.sin(s), z=0.1 * np.sin(2 * s))).to_csv(path, index=False)
+    return str(path)
+
+
+@pytest.mark.parametrize("argv, words", [
+    (["run", "--g0", "60", "--theta0", "30", "--n", "500"], ["--n", "at most 128", "500"]),
+    (["run", "--g0", "60", "--theta0", "30", "--n", "auto", "--n-max", "100000"],
+     ["--n-max", "100000"]),
+    (["run", "--g0", "60", "--theta0", "30", "--snapshots", "10000000"],
+     ["--snapshots", "10000000"]),
+    (["run", "--g0", "60", "--theta0", "30", "--out", ""], ["--out is empty"]),
+    (["run", "--g0", "60", "--initial", "/dev/zero"], ["/dev/zero", "not a regular file"]),
+    (["sweep", "--g0", "1:2:1000000000", "--theta0", "30", "--out", "{tmp}/s"],
+     ["--g0", "1000000000"]),
+    (["sweep", "--g0", "1:2:1000", "--theta0", "1:80:1001", "--out", "{tmp}/s"],
+     ["1001000 cases"]),
+    (["sweep", "--g0", "10", "--theta0", "30", "--n", "200", "--out", "{tmp}/s"],
+     ["n must be at most 128"]),
+    (["sweep", "--g0", "10", "--theta0", "30", "--snapshots-for", "0", "--snapshots",
+      "100000", "--out", "{tmp}/s"], ["100000"]),
+    (["sweep", "--cases", "/dev/zero", "--out", "{tmp}/s"], ["not a regular file"]),
+    (["sweep", "--g0", "10", "--theta0", "30", "--out", ""], ["--out is empty"]),
+    (["stability", "--paper", "--n-max", "100000"], ["--n-max", "100000"]),
+    (["stability", "--n", "100000"], ["--n", "100000"]),
+])
+def test_sizes_refused_in_one_line_before_work(tmp_path, capsys, argv, words):
+    argv = [a.replace("{tmp}", str(tmp_path)) for a in argv]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1 and all(w in err for w in words), err
+    assert not (tmp_path / "s").exists()
+
+
+def test_point_files_bounded_by_size_rows_and_kind(tmp_path, capsys):
+    fifo = str(tmp_path / "fifo")
+    os.mkfifo(fifo)  # opening it would block: refused from its kind
+    big = str(tmp_path / "big.csv")
+    with open(big, "wb") as handle:  # a sparse file: no disk used
+        handle.truncate(validation.MAX_POINT_FILE_BYTES + 1)
+    rows = _point_file(tmp_path / "rows.csv", validation.MAX_POINTS + 1)
+    for path, word in ((fifo, "not a regular file"), (big, "MiB"),
+                       (rows, f"more than {validation.MAX_POINTS} points")):
+        assert main(["run", "--g0", "60", "--initial", path]) == 2
+        err = capsys.readouterr().err
+        assert len(err.splitlines()) == 1 and word in err and path in err, err
+
+
+def test_cases_file_rows_bounded(tmp_path, capsys, monkeypatch):
+    monkeypatch.setattr(validation, "MAX_CASES", 3)
+    path = tmp_path / "cases.csv"
+    path.write_text("g0,theta0_deg\n" + "10,30\n" * 4)
+    assert main(["sweep", "--cases", str(path), "--out", str(tmp_path / "s")]) == 2
+    err = capsys.readouterr().err
+    assert "more than 3 rows" in err and not (tmp_path / "s").exists()
+
+
+# ---- loopsim run: signals and temporaries -------------------------------------------------
+def _handler_installed(pid, signum):
+    """Whether process ``pid`` catches ``signum`` (Linux: SigCgt in /proc/PID/status)."""
+    with open(f"/proc/{pid}/status") as handle:
+        for line in handle:
+            if line.startswith("SigCgt:"):
+                return bool(int(line.split()[1], 16) >> (signum - 1) & 1)
+    return False
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+@pytest.mark.parametrize("signum, status", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_run_stops_on_a_signal_in_one_line(tmp_path, signum, status):
+    """A long 3D run: the signal lands during the integration (its SIGTERM handler is
+    installed just before it starts); exit 130 / 143 within seconds, one line, no
+    traceback, nothing written.  It used to exit 1 with a SystemError."""
+    out = tmp_path / "run.parquet"
+    process = subprocess.Popen(
+        [sys.executable, "-m", "loopsim", "run", "--g0", "300", "--theta0", "80", "--n", "8",
+         "--t-end", "40", "--out", str(out)], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+        text=True)
+    deadline = time.monotonic() + 60
+    while not _handler_installed(process.pid, signal.SIGTERM):
+        assert process.poll() is None and time.monotonic() < deadline, process.communicate()
+        time.sleep(0.05)
+    time.sleep(0.5)
+    sent = time.monotonic()
+    process.send_signal(signum)
+    stdout, stderr = process.communicate(timeout=60)
+    assert time.monotonic() - sent < 5.0
+    assert process.returncode == status, stderr
+    assert stderr.splitlines() == [
+        f"loopsim: interrupted by {signal.Signals(signum).name}: the run was stopped; "
+        "nothing written"], stderr
+    assert stdout == "" and os.listdir(tmp_path) == []
+
+
+def test_run_out_removes_temporaries_of_killed_runs_only(tmp_path, capsys):
+    host = socket.gethostname()
+    child = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                           capture_output=True, text=True, check=True)
+    dead = tmp_path / f".tmp-{host}-{int(child.stdout)}-abc.parquet"  # a run killed mid-write
+    live = tmp_path / f".tmp-{host}-{os.getpid()}-abc.parquet"  # a process still writing
+    dead.write_bytes(b"partial")
+    live.write_bytes(b"partial")
+    out = tmp_path / "run.parquet"
+    assert main(["run", "--g0", "60", "--theta0", "30", "--n", "4", "--t-end", "0.05",
+                 "--out", str(out)]) == 0
+    assert out.exists() and live.exists() and not dead.exists()
+    io.read_table_checked(str(out), require_hash=True)
+
+
+def test_edited_sweep_file_is_damaged(sweep):
+    """A flipped value in _sweep.json's configuration no longer matches its fingerprint."""
+    path = os.path.join(sweep, io.SWEEP_FILE)
+    text = open(path).read()
+    assert '"t_end": 0.2' in text
+    open(path, "w").write(text.replace('"t_end": 0.2', '"t_end": 0.3'))
+    with pytest.raises(ValueError, match="_sweep.json' is damaged.*fingerprint"):
+        loopsim.read_results(sweep)
+
+
+def test_lost_sidecar_and_damaged_file_repaired_together(sweep, pristine):
+    """_sweep.json lost and a result file truncated: the same sweep restores the one and
+    recomputes the other; a stray copy is ignored with a warning, never merged."""
+    os.remove(os.path.join(sweep, io.SWEEP_FILE))
+    os.truncate(os.path.join(sweep, io.CHUNK_PATTERN.format(1, 2)), 100)
+    shutil.copy(os.path.join(sweep, io.CHUNK_PATTERN.format(0, 1)),
+                os.path.join(sweep, "chunk-0000000-0000001 (copy).parquet"))
+    with pytest.warns(UserWarning) as caught:
+        frame = ensemble.run_sweep(_config(), sweep, threads=1, quiet=True)
+    messages = [str(w.message) for w in caught]
+    assert any("damaged" in m for m in messages) and any("stray copy" in m for m in messages)
+    _same_rows(frame, pristine[1])
+    assert io.read_sweep_file(sweep)["checksums"] == io.CONTENT_KEY
