@@ -180,12 +180,14 @@ def simulate(
     if refine:
         n = n_start if n_start is not None else (
             refinement.AUTO_START if initial is None else None)
+        n_max = validation.check_order("n_max", n_max)
     elif n_start is not None:
         raise ValueError("n_start applies only with n='auto'")
+    if n is not None:
+        n = validation.check_order("n_start" if refine else "n", n)
     x0, theta0_deg, n, perturbation, initial_info = shapes.start_shape(
         theta0_deg, n, perturbation, seed, initial, initial_case_id)
-    ladder = refinement.orders(n, max(n, validation.check_integer("n_max", n_max, 1))) \
-        if refine else (n,)
+    ladder = refinement.orders(n, max(n, n_max)) if refine else (n,)
     if method == "auto":
         method = refinement.auto_method(stability_parameter(g0, theta0_deg), n, refine)
     method_object = integrators.METHODS[method]

@@ -146,6 +146,10 @@ def test_simulate_auto_records_the_order_reached_and_the_method():
     assert summary["n_used"] == result.n_used and summary["method"] == "radau5"
     with pytest.raises(ValueError, match="n"):
         loopsim.simulate(150.0, 60.0, n="automatic")
+    with pytest.raises(ValueError, match="n_max must be at most 128"):
+        loopsim.simulate(150.0, 60.0, n="auto", n_max=200)
+    with pytest.raises(ValueError, match="n_start applies only"):
+        loopsim.simulate(150.0, 60.0, n=8, n_start=6)
 
 
 def test_auto_method_by_expected_regime():
