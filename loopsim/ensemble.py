@@ -183,16 +183,38 @@ def _cell(path, row, column, value, integer):
     return number
 
 
+#: Optional per-case columns of a cases file that override the sweep's option.
+CASE_OVERRIDES = ("method", "rtol", "t_end")
+
+
 def _case_row(path, i, row):
-    """A case dict from one row of a cases file (types checked, cell by cell)."""
-    return dict(g0=_cell(path, i, "g0", row.g0, False),
+    """A case dict from one row of a cases file (types checked, cell by cell); the
+    optional ``CASE_OVERRIDES`` enter only where the cell is given."""
+    case = dict(g0=_cell(path, i, "g0", row.g0, False),
                 theta0_deg=_cell(path, i, "theta0_deg", row.theta0_deg, False),
                 n=_cell(path, i, "n", row.n, True), seed=_cell(path, i, "seed", row.seed, True),
                 perturbation=_cell(path, i, "perturbation", row.perturbation, False))
+    for key in ("rtol", "t_end"):
+        value = getattr(row, key, None)
+        if value is not None and not (isinstance(value, float) and math.isnan(value)):
+            case[key] = _cell(path, i, key, value, False)
+    method = getattr(row, "method", None)
+    if isinstance(method, str) and method.strip():
+        if method.strip() not in refinement.METHOD_CHOICES:
+            raise ValueError(f"cases file {path!r}, row {i}, column method: must be one of "
+                             f"{', '.join(refinement.METHOD_CHOICES)}, got {method!r}")
+        case["method"] = method.strip()
+    return case
+
+
+def case_option(config, case, key):
+    """A case's ``rtol`` or ``t_end``: its own (a cases-file column) or the sweep's."""
+    return case.get(key, getattr(config, key))
 
 
 def read_cases_file(path, perturbation=DEFAULT_PERTURBATION, n=6):
-    """Cases from a CSV or Parquet table: columns g0, theta0_deg (required), n, seed, perturbation."""
+    """Cases from a CSV or Parquet table: columns g0, theta0_deg (required), n, seed,
+    perturbation, and per case (overriding the sweep's options) method, rtol, t_end."""
     validation.check_input_file("cases file", path, validation.MAX_CASES_FILE_BYTES)
     limit = validation.MAX_CASES
     try:
@@ -245,6 +267,11 @@ def validate(config):
             validation.check_order("n", case["n"])
             validation.check_integer("seed", case["seed"], 0)
             validation.check_real("perturbation", case["perturbation"], low=0.0)
+            for key in ("rtol", "t_end"):
+                if key in case:
+                    validation.check_real(key, case[key], low=0.0, low_open=True)
+            if "method" in case:
+                validation.check_choice("method", case["method"], refinement.METHOD_CHOICES)
         except ValueError as exc:
             raise ValueError(f"case {case_id}: {exc}") from None
     validation.check_real("t_end", config.t_end, low=0.0, low_open=True)
@@ -274,9 +301,10 @@ def _start(case):
 
 
 def case_method(config, case):
-    """The integrator of a case: the sweep's, or chosen per case (``method = "auto"``)."""
-    if config.method != "auto":
-        return config.method
+    """The integrator of a case: its own or the sweep's, chosen per case if "auto"."""
+    method = case.get("method", config.method)
+    if method != "auto":
+        return method
     return refinement.auto_method(diagnostics.stability_parameter(case["g0"], case["theta0_deg"]),
                                   case["n"], config.n_auto)
 
@@ -296,8 +324,9 @@ def _result_row(config, case_id, case, x0, x, status_code, counts, worst, wall_s
         x = spectral.resize(x0, n_used)  # keep the row finite; the status says why
     problem = models.local_sbt.make_problem(n_used, case["g0"], config.w)
     u, multiplier = api.velocity_and_multiplier(problem, x)
-    inputs = dict(g0=case["g0"], theta0_deg=case["theta0_deg"], n=case["n"], t_end=config.t_end,
-                  rtol=config.rtol, atol=config.atol, w=config.w,
+    inputs = dict(g0=case["g0"], theta0_deg=case["theta0_deg"], n=case["n"],
+                  t_end=case_option(config, case, "t_end"),
+                  rtol=case_option(config, case, "rtol"), atol=config.atol, w=config.w,
                   perturbation=case["perturbation"], seed=case["seed"])
     row = api.terminal_summary(
         inputs, x, u, multiplier, method=method, n_used=n_used,
@@ -321,8 +350,9 @@ def _traced_case(config, case_id):
     method = case_method(config, case)
     start = dict(_start(case), **({"n": "auto", "n_start": case["n"]} if config.n_auto else {}))
     result = api.simulate(
-        case["g0"], **start, t_span=(0.0, config.t_end),
-        snapshots=config.snapshot_count, rtol=config.rtol, atol=config.atol, w=config.w,
+        case["g0"], **start, t_span=(0.0, case_option(config, case, "t_end")),
+        snapshots=config.snapshot_count, rtol=case_option(config, case, "rtol"),
+        atol=config.atol, w=config.w,
         method=method, max_steps=config.max_steps, length_tol=config.length_tol,
         steady_tol=config.steady_tol if config.early_stop else None,
         steady_interval=config.steady_interval, n_max=config.n_max, tail_tol=config.tail_tol)
@@ -343,7 +373,7 @@ def run_chunk(config, chunk, threads):
 
     Returns (results Table in RESULT_SCHEMA, snapshots Table or None).  Cases
     without snapshots run in the parallel batch kernel (``refinement.integrate_cases``:
-    a fixed n is a ladder of one order), grouped by starting n and method; their
+    a fixed n is a ladder of one order), grouped by starting n, method and rtol; their
     ``wall_s`` is the batch's wall time x threads shared in proportion to RHS
     evaluations.
     """
@@ -353,15 +383,17 @@ def run_chunk(config, chunk, threads):
     for case_id in ids:
         if case_id not in traced:
             case = config.cases[case_id]
-            groups.setdefault((case["n"], case_method(config, case)), []).append(case_id)
+            key = (case["n"], case_method(config, case), case_option(config, case, "rtol"))
+            groups.setdefault(key, []).append(case_id)
     start = time.perf_counter()
     outputs = []
-    for (n, method), members in sorted(groups.items()):
+    for (n, method, rtol), members in sorted(groups.items()):
         cases = [config.cases[i] for i in members]
         x0 = [shapes.start_shape(**_start(c))[0] for c in cases]
         result = refinement.integrate_cases(
             integrators.METHODS[method], [(c["g0"], config.w) for c in cases], x0,
-            config.t_end, config.step_options(), case_ladder(config, cases[0]),
+            [case_option(config, c, "t_end") for c in cases],
+            config.step_options()._replace(rtol=float(rtol)), case_ladder(config, cases[0]),
             config.tail_tol,
             cost=[diagnostics.stability_parameter(c["g0"], c["theta0_deg"]) for c in cases])
         outputs.append((members, x0, method, result))

@@ -306,3 +306,26 @@ def test_too_many_threads_refused_before_the_directory_is_made(tmp_path, capsys)
     assert main(["sweep", "--g0", "60", "--theta0", "30", "--threads", "1000",
                  "--out", str(out)]) == 2
     assert "--threads" in capsys.readouterr().err and not out.exists()
+
+
+def test_cases_file_sets_method_rtol_and_t_end_per_row(tmp_path, capsys):
+    """Cells of the optional columns method, rtol and t_end override the sweep's options
+    for their row only; the row records them, and it equals a single run with them."""
+    path = tmp_path / "cases.csv"
+    path.write_text("g0,theta0_deg,n,method,rtol,t_end\n60,30,4,radau5,1e-8,0.3\n"
+                    "150,60,4,,,\n")
+    out = tmp_path / "per_row"
+    assert main(["sweep", "--cases", str(path), "--t-end", "0.5", "--quiet",
+                 "--out", str(out)]) == 0
+    frame = loopsim.read_results(str(out))
+    first, second = frame.iloc[0], frame.iloc[1]
+    assert (first["method"], first["rtol"], first["t_end"]) == ("radau5", 1e-8, 0.3)
+    assert (second["method"], second["rtol"], second["t_end"]) == ("rkf45", 1e-6, 0.5)
+    assert first["t_final"] == 0.3 and second["t_final"] == 0.5
+    single = loopsim.simulate(60.0, 30.0, n=4, method="radau5", rtol=1e-8, t_span=(0, 0.3),
+                              steady_tol=1e-6)
+    np.testing.assert_array_equal(single.x_final.ravel(), first["x_final"])
+    path.write_text("g0,theta0_deg,method\n60,30,euler\n")
+    assert main(["sweep", "--cases", str(path), "--out", str(tmp_path / "bad")]) == 2
+    err = capsys.readouterr().err
+    assert "row 0, column method" in err and "euler" in err
