@@ -1,9 +1,11 @@
 """Command-line interface: ``loopsim run``, ``loopsim sweep`` and ``loopsim stability``.
 
 Errors in the input end with one line ``loopsim: error: ...`` on stderr and
-exit status 2; a run that fails numerically exits 1 after printing its summary.
+exit status 2; a run that fails numerically exits 1 after printing its summary; the
+machine refusing to go on (disk full, read-only filesystem, I/O error) exits 3.
 """
 import argparse
+import errno
 import contextlib
 import json
 import math
@@ -21,6 +23,10 @@ from .integrators import METHODS  # noqa: E402 - the names only; no kernel is co
 
 EXIT_FAILED_RUN = 1
 EXIT_USAGE = 2
+EXIT_ENVIRONMENT = 3
+#: OSError numbers that are the machine's fault, not the input's: exit EXIT_ENVIRONMENT.
+ENVIRONMENT_ERRORS = {errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EIO, errno.ENOMEM,
+                      errno.EMFILE, errno.ENFILE}
 
 
 class _HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
@@ -132,7 +138,8 @@ def _build_parser():
         "chunk files in DIR, a Parquet dataset (pandas.read_parquet(DIR); checked: "
         "loopsim.read_results(DIR)). Re-running the same command resumes (also with another "
         "--chunk-size). Exit status: 0 every case ok; 1 some case failed (its row says why; "
-        "see --rerun-failed); 2 bad input; 130 / 143 stopped by SIGINT / SIGTERM (finished "
+        "see --rerun-failed); 2 bad input; 3 disk full, read-only filesystem or I/O error "
+        "(re-run to resume once fixed); 130 / 143 stopped by SIGINT / SIGTERM (finished "
         "cases kept: re-run to resume).",
         formatter_class=_HelpFormatter,
     )
@@ -688,6 +695,8 @@ def main(argv=None):
             return handlers[args.command](args)
     except (ValueError, OSError) as exc:
         print(f"loopsim: error: {exc}", file=sys.stderr)
+        if isinstance(exc, OSError) and exc.errno in ENVIRONMENT_ERRORS:
+            return EXIT_ENVIRONMENT
         return EXIT_USAGE
 
 

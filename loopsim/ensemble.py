@@ -266,7 +266,7 @@ def validate(config):
             validation.check_tilt("theta0_deg", case["theta0_deg"])
             validation.check_order("n", case["n"])
             validation.check_integer("seed", case["seed"], 0)
-            validation.check_real("perturbation", case["perturbation"], low=0.0)
+            validation.check_perturbation("perturbation", case["perturbation"])
             for key in ("rtol", "t_end"):
                 if key in case:
                     validation.check_real(key, case[key], low=0.0, low_open=True)

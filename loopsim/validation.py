@@ -18,6 +18,20 @@ def check_real(name, value, low=-math.inf, high=math.inf, low_open=False):
     return value
 
 
+#: Largest RMS size of the seeded perturbation: half the loop's radius (lengths in L/2π,
+#: so the unperturbed loop has radius 1).  Beyond it the "perturbation" is the shape.
+MAX_PERTURBATION = 0.5
+
+
+def check_perturbation(name, value):
+    """An RMS perturbation size in [0, MAX_PERTURBATION], as float."""
+    value = check_real(name, value, low=0.0)
+    if value > MAX_PERTURBATION:
+        raise ValueError(f"{name} must be at most {MAX_PERTURBATION} (half the loop's radius: a "
+                         f"larger one is not a perturbation of the loop), got {value!r}")
+    return value
+
+
 def check_integer(name, value, low):
     """An integer ≥ low (bools refused), as int."""
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Integral) \

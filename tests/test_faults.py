@@ -333,3 +333,44 @@ def test_lost_sidecar_and_damaged_file_repaired_together(sweep, pristine):
     assert any("damaged" in m for m in messages) and any("stray copy" in m for m in messages)
     _same_rows(frame, pristine[1])
     assert io.read_sweep_file(sweep)["checksums"] == io.CONTENT_KEY
+
+
+def test_disk_full_is_an_environment_error_and_the_sweep_resumes(tmp_path, capsys, monkeypatch):
+    """Writing a result file fails with ENOSPC: one line, exit 3 (not 2, bad input), no
+    temporary left; once space is back the same command resumes to the full table."""
+    import errno
+
+    import pyarrow.parquet as parquet
+
+    from loopsim.cli import EXIT_ENVIRONMENT, main
+
+    out = tmp_path / "full"
+    argv = ["sweep", "--g0", "30,60", "--theta0", "30", "--n", "4", "--t-end", "0.2",
+            "--quiet", "--out", str(out)]
+    real_write = parquet.write_table
+
+    def no_space(*args, **kwargs):
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(parquet, "write_table", no_space)
+    assert main(argv) == EXIT_ENVIRONMENT == 3
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "No space left on device" in err[0]
+    assert not list(out.glob(".tmp-*"))
+    monkeypatch.setattr(parquet, "write_table", real_write)
+    assert main(argv) == 0
+    assert len(loopsim.read_results(str(out))) == 2
+
+
+def test_perturbation_larger_than_the_loop_is_refused(tmp_path, capsys):
+    from loopsim.cli import main
+
+    assert main(["run", "--g0", "60", "--theta0", "30", "--perturbation", "2"]) == 2
+    err = capsys.readouterr().err
+    assert "perturbation must be at most 0.5" in err and len(err.strip().splitlines()) == 1
+    out = tmp_path / "s"
+    assert main(["sweep", "--g0", "60", "--theta0", "30", "--perturbation", "0.9",
+                 "--out", str(out)]) == 2
+    assert "perturbation" in capsys.readouterr().err
+    with pytest.raises(ValueError, match="perturbation"):
+        loopsim.simulate(60.0, 30.0, perturbation=1.0)

@@ -294,7 +294,7 @@ def start_shape(theta0_deg=None, n=None, perturbation=None, seed=0, initial=None
     if n is not None:
         n = validation.check_order("n", n)
     perturbation = default_perturbation(initial is not None) if perturbation is None \
-        else validation.check_real("perturbation", perturbation, low=0.0)
+        else validation.check_perturbation("perturbation", perturbation)
     seed = validation.check_integer("seed", seed, 0)
     if initial is None:
         if initial_case_id is not None:
