@@ -174,9 +174,9 @@ def simulate(
     g0 = validation.check_real("g0", g0, low=0.0)
     method = validation.check_choice("method", method, refinement.METHOD_CHOICES)
     refine = isinstance(n, str)
+    tail_tol = validation.check_real("tail_tol", tail_tol, low=0.0, low_open=True)
     if refine:
         validation.check_choice("n", n, ("auto",))
-        tail_tol = validation.check_real("tail_tol", tail_tol, low=0.0, low_open=True)
     if refine:
         n = n_start if n_start is not None else (
             refinement.AUTO_START if initial is None else None)

@@ -148,6 +148,8 @@ def test_simulate_auto_records_the_order_reached_and_the_method():
         loopsim.simulate(150.0, 60.0, n="automatic")
     with pytest.raises(ValueError, match="n_max must be at most 128"):
         loopsim.simulate(150.0, 60.0, n="auto", n_max=200)
+    with pytest.raises(ValueError, match="tail_tol"):
+        loopsim.simulate(150.0, 60.0, n=6, tail_tol=0.0)  # checked even for a fixed n
     with pytest.raises(ValueError, match="n_start applies only"):
         loopsim.simulate(150.0, 60.0, n=8, n_start=6)
 
