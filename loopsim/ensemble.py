@@ -345,7 +345,8 @@ def _result_row(config, case_id, case, x0, x, status_code, counts, worst, wall_s
 
 def _traced_case(config, case_id):
     """A case with snapshots: its row and trajectory come from one ``api.simulate`` run,
-    so they agree exactly (its steps land on the snapshot times)."""
+    so they agree exactly (snapshots come from dense output: the steps, and so the row,
+    are those of the batch kernel)."""
     case = config.cases[case_id]
     method = case_method(config, case)
     start = dict(_start(case), **({"n": "auto", "n_start": case["n"]} if config.n_auto else {}))
@@ -356,8 +357,7 @@ def _traced_case(config, case_id):
         method=method, max_steps=config.max_steps, length_tol=config.length_tol,
         steady_tol=config.steady_tol if config.early_stop else None,
         steady_interval=config.steady_interval, n_max=config.n_max, tail_tol=config.tail_tol)
-    x0 = shapes.start_shape(**_start(case))[0]
-    row = _result_row(config, case_id, case, x0, result.x_final, result.status_code,
+    row = _result_row(config, case_id, case, result.x[0], result.x_final, result.status_code,
                       [getattr(result, name) for name in integrators.COUNTS],
                       (result.length_error_max, result.tail_max), result.wall_s,
                       result.t_final, method)
