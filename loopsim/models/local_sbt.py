@@ -29,7 +29,7 @@ import numpy as np
 
 from .. import spectral
 from ..config import JIT
-from ..linalg import least_squares_affine
+from ..linalg import least_squares_affine, least_squares_normal
 from .base import (
     auxiliary, constraint_error, for_case, implements, jacobian, resolution_error, rhs,
     steady_invariants,
@@ -40,8 +40,11 @@ from .base import (
 #: F: (K, M) projection onto order n; P = S0 F and P1 = S1 F: (M, M)
 #: grid-to-grid projection and projected derivative.
 #: S1T, S2T, S4T, FT: C-contiguous transposes for (3, ·) @ (·, ·) products.
+#: S0T, P1T, P2T: the transposes of S0, P1 and P2 = S2 F (the fast path, tension_operator);
+#: column_scale: 1 / (1 + 2k²) per tension coefficient, which equilibrates the columns of
+#: the map T -> ε (leading order 2 T'') for the normal-equations solve.
 LoopOperators = collections.namedtuple(
-    "LoopOperators", "n m S0 S1 S2 S4 F P P1 S1T S2T S4T FT"
+    "LoopOperators", "n m S0 S1 S2 S4 F P P1 S1T S2T S4T FT S0T P1T P2T column_scale"
 )
 
 #: Per-case scratch arrays, so the right-hand side never allocates.  Column
@@ -50,9 +53,13 @@ LoopOperators = collections.namedtuple(
 #: ``length_rate`` (K+1, M) is the affine map T -> ε stored column by column (row j:
 #: the column of T = φ_j; row K: the affine part), as LAPACK's QR wants it; ``tau``
 #: is the QR's scratch.
+#: The fast path's scratch: ``coupling`` (2M, M) holds Bᵀ over B₂ᵀ (tension_operator),
+#: ``partial`` (K, M) is S0ᵀ Bᵀ, ``fields`` (3, 3, M) grid fields, ``gram`` (K, K) the
+#: normal equations.
 Workspace = collections.namedtuple(
     "Workspace",
-    "tangent curvature x4 raw force mobile dmobile length_rate velocity tension tau"
+    "tangent curvature x4 raw force mobile dmobile length_rate velocity tension tau "
+    "coupling partial fields gram"
 )
 
 
@@ -71,7 +78,8 @@ def make_operators(n):
     c = np.ascontiguousarray
     return LoopOperators(
         n, m, c(S[0]), c(S[1]), c(S[2]), c(S[3]), c(F), c(S[0] @ F), c(S[1] @ F),
-        c(S[1].T), c(S[2].T), c(S[3].T), c(F.T),
+        c(S[1].T), c(S[2].T), c(S[3].T), c(F.T), c(S[0].T), c((S[1] @ F).T),
+        c((S[2] @ F).T), 1.0 / (1.0 + 2.0 * spectral.wavenumbers(n) ** 2),
     )
 
 
@@ -83,7 +91,8 @@ def make_workspace(n):
         np.empty((3, m)), np.empty((3, m)), np.empty((3, m)),
         np.empty((m, 3, k + 1)), np.empty((m, 3, k + 1)), np.empty((m, 3, k + 1)),
         np.empty((m, 3, k + 1)), np.empty((k + 1, m)), np.empty((3, m)), np.empty(k),
-        np.empty(k),
+        np.empty(k), np.empty((2 * m, m)), np.empty((k, m)), np.empty((3, 3, m)),
+        np.empty((k, k)),
     )
 
 
@@ -149,8 +158,96 @@ def compose_maps(x, g0, w, ops, ws):
 
 
 @numba.njit(**JIT)
+def tension_operator(ops, ws):
+    """Bᵀ and B₂ᵀ into ws.coupling: B = P1 ∘ G, B₂ = P2 ∘ G, G_il = t_i·t_l (t = x' on the grid).
+
+    With T the tension's grid values, f_c = P1(t_c T) − x⁗_c − g0 δ_cz (the
+    projected force: (T x')' has order 2n, so P_n of it is P1 applied to T x'),
+    h = t·f and m_c = f_c + h t_c, the length creation is
+
+        ε = Σ_c t_c P1 m_c − w(1 − |t|²)
+          = Σ_c t_c P2 (t_c T) + Σ_c t_c P1 (t_c h) + (the T = 0 part)
+          = B₂ T + B (B T) + b,
+
+    because P1 P1 = S1 (F S1) F = S1 D F = P2 and Σ_c t_c P (t_c v) = (P ∘ G) v.
+    """
+    m = ops.m
+    t = ws.tangent
+    coupling = ws.coupling
+    for l in range(m):
+        for i in range(m):
+            g = t[0, i] * t[0, l] + t[1, i] * t[1, l] + t[2, i] * t[2, l]
+            coupling[l, i] = ops.P1T[l, i] * g
+            coupling[m + l, i] = ops.P2T[l, i] * g
+
+
+@numba.njit(**JIT)
+def length_rate_operator(g0, w, ops, ws):
+    """The affine map T -> ε into ws.length_rate: rows 0..K-1 the columns of
+    A = (B₂ + B B) S0 (stored Aᵀ = S0ᵀ B₂ᵀ + (S0ᵀ Bᵀ) Bᵀ), row K the T = 0 part b.
+
+    Needs ws.tangent and ws.x4 (:func:`shape_on_grid`); leaves Bᵀ, B₂ᵀ in ws.coupling
+    and the T = 0 force in ws.fields[0].
+    """
+    m, k = ops.m, ops.S0.shape[1]
+    tension_operator(ops, ws)
+    b_t = ws.coupling[:m]
+    b2_t = ws.coupling[m:]
+    a_t = ws.length_rate[:k]
+    np.dot(ops.S0T, b_t, ws.partial)  # (B S0)ᵀ
+    np.dot(ops.S0T, b2_t, a_t)
+    extra = np.dot(ws.partial, b_t)
+    for j in range(k):
+        for i in range(m):
+            a_t[j, i] += extra[j, i]
+    t, force, mobile = ws.tangent, ws.fields[0], ws.fields[1]
+    for i in range(m):
+        for c in range(3):
+            force[c, i] = -ws.x4[c, i] - (g0 if c == 2 else 0.0)
+        h = t[0, i] * force[0, i] + t[1, i] * force[1, i] + t[2, i] * force[2, i]
+        for c in range(3):
+            mobile[c, i] = force[c, i] + h * t[c, i]
+    dmobile = np.dot(mobile, ops.P1T)
+    b = ws.length_rate[k]
+    for i in range(m):
+        stretch = t[0, i] ** 2 + t[1, i] ** 2 + t[2, i] ** 2
+        b[i] = (t[0, i] * dmobile[0, i] + t[1, i] * dmobile[1, i] + t[2, i] * dmobile[2, i]
+                - w * (1.0 - stretch))
+
+
+@numba.njit(**JIT)
 def loop_velocity(x, g0, w, ops, ws, u_out):
     """Velocity coefficients u (3, K) of the shape x (3, K); tension left in ws.tension.
+
+    u_c = F m_c, m_c = f_c + (t·f) t_c, f_c = P1(t_c T) − x⁗_c − g0 δ_cz, with T the
+    least-squares tension of :func:`length_rate_operator`: the same map as
+    :func:`loop_velocity_blocks`, at about half the cost.
+    """
+    m = ops.m
+    shape_on_grid(x, ops, ws)
+    length_rate_operator(g0, w, ops, ws)
+    if least_squares_normal(ws.length_rate, ops.column_scale, ws.tension, ws.gram) != 0:
+        least_squares_affine(ws.length_rate, ws.tension, ws.tau)
+    t = ws.tangent
+    tension = np.dot(ops.S0, ws.tension)
+    weighted = ws.fields[2]
+    for c in range(3):
+        for i in range(m):
+            weighted[c, i] = t[c, i] * tension[i]
+    force = np.dot(weighted, ops.P1T)
+    for i in range(m):
+        for c in range(3):
+            force[c, i] += ws.fields[0, c, i]
+        h = t[0, i] * force[0, i] + t[1, i] * force[1, i] + t[2, i] * force[2, i]
+        for c in range(3):
+            ws.velocity[c, i] = force[c, i] + h * t[c, i]
+    np.dot(ws.velocity, ops.FT, u_out)
+
+
+@numba.njit(**JIT)
+def loop_velocity_blocks(x, g0, w, ops, ws, u_out):
+    """:func:`loop_velocity` through the column blocks of :func:`compose_maps`: the
+    previous dense path, kept as the Jacobian's first step and as the fast path's reference.
 
     The least-squares solve destroys ws.length_rate; the residual is not kept.
     """
@@ -252,7 +349,7 @@ def loop_jacobian(x, g0, w, ops, ws, jac):
     with ε = A T + b, r = ε(T) the residual and m_T the tension columns of m.
     """
     u = np.empty_like(x)
-    loop_velocity(x, g0, w, ops, ws, u)  # fills the column blocks and ws.tension
+    loop_velocity_blocks(x, g0, w, ops, ws, u)  # fills the column blocks and ws.tension
     m, k = ops.m, ops.S0.shape[1]
     d = 3 * k
     tau = ws.tension
