@@ -1,0 +1,127 @@
+"""The fast right-hand side against the previous dense path, whole trajectories, in one process.
+
+Usage: python scripts/bench_paths.py [--cases 100:60,150:45,150:80] [--orders 16,24,32]
+                                     [--t-end 10] [--rtol 1e-6] [--repeats 2] [--out FILE.json]
+
+Both paths integrate the same start (``shapes.initial_shape``, perturbation 1e-3,
+seed 0) with radau5 and the same exact Jacobian; only the RHS differs:
+``local_sbt.loop_velocity`` (the tension map as (B₂ + B B) S0, corrected
+semi-normal equations) against ``loop_velocity_blocks`` (column blocks through
+two (M, M) projections and Householder QR: the code before this change),
+registered here as a second model type.  The two are run alternately,
+``--repeats`` times each, best wall time kept, so both see the same machine
+load.  Prints wall times, the speed-up, the work counts (equal when both
+paths take the same steps) and the terminal difference.
+"""
+import argparse
+import collections
+import json
+import time
+
+import numpy as np
+
+import loopsim
+from loopsim import integrators, shapes
+from loopsim.integrators.driver import integrate
+from loopsim.models import (auxiliary, constraint_error, implements, jacobian, local_sbt,
+                            resolution_error, rhs, steady_invariants)
+
+#: The previous dense path as its own model type (same fields as LoopProblem).
+DenseLoopProblem = collections.namedtuple("DenseLoopProblem", local_sbt.LoopProblem._fields)
+
+
+@implements(rhs, DenseLoopProblem)
+def _dense_rhs(problem, y, dydt):
+    k = y.shape[0] // 3
+    local_sbt.loop_velocity_blocks(y.reshape((3, k)), problem.g0, problem.w, problem.ops,
+                                   problem.ws, dydt.reshape((3, k)))
+
+
+@implements(jacobian, DenseLoopProblem)
+def _dense_jacobian(problem, y, f, jac, work_y, work_f):
+    k = y.shape[0] // 3
+    local_sbt.loop_jacobian(y.reshape((3, k)), problem.g0, problem.w, problem.ops, problem.ws,
+                            jac)
+    return 1
+
+
+@implements(constraint_error, DenseLoopProblem)
+def _dense_length_error(problem, y):
+    k = y.shape[0] // 3
+    return local_sbt.relative_length_error(y.reshape((3, k)), problem.ops, problem.ws)
+
+
+@implements(resolution_error, DenseLoopProblem)
+def _dense_tail(problem, y):
+    k = y.shape[0] // 3
+    return local_sbt.spectral_tail(y.reshape((3, k)))
+
+
+@implements(steady_invariants, DenseLoopProblem)
+def _dense_invariants(problem, y):
+    k = y.shape[0] // 3
+    return local_sbt.shape_invariants(y.reshape((3, k)))
+
+
+@implements(auxiliary, DenseLoopProblem)
+def _dense_multiplier(problem, out):
+    out[:] = problem.ws.tension
+
+
+def run(problem, x0, t_end, options):
+    y_out = np.empty((1, x0.size))
+    start = time.perf_counter()
+    status, t, y, counts, _ = integrate(integrators.RADAU5, problem, x0.ravel().copy(), 0.0,
+                                        t_end, np.array([t_end]), options, y_out)
+    return time.perf_counter() - start, int(status), y.reshape(x0.shape), counts
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--cases", default="100:60,150:45,150:80")
+    parser.add_argument("--orders", default="16,24,32")
+    parser.add_argument("--t-end", type=float, default=10.0)
+    parser.add_argument("--rtol", type=float, default=1e-6)
+    parser.add_argument("--repeats", type=int, default=2)
+    parser.add_argument("--out")
+    args = parser.parse_args()
+    options = integrators.step_options(args.rtol, args.rtol * 1e-3)
+    w = loopsim.config.DEFAULT_W
+    warm = shapes.initial_shape(4, np.radians(30.0), 1e-3, 0)
+    for make in (local_sbt.LoopProblem, DenseLoopProblem):  # compile outside the timing
+        run(make(60.0, w, local_sbt.make_operators(4), local_sbt.make_workspace(4)), warm, 0.01,
+            options)
+    rows = []
+    print(f"{'g0':>5} {'th0':>4} {'n':>3} {'dense_s':>8} {'fast_s':>8} {'speedup':>7} "
+          f"{'nfev':>7} {'njev':>5} {'nlu':>5} {'steps':>6} {'max|dx|':>8}")
+    for case in args.cases.split(","):
+        g0, theta0 = (float(v) for v in case.split(":"))
+        for n in (int(v) for v in args.orders.split(",")):
+            x0 = shapes.initial_shape(n, np.radians(theta0), 1e-3, 0)
+            ops = local_sbt.make_operators(n)
+            best = {"dense": np.inf, "fast": np.inf}
+            result = {}
+            for _ in range(args.repeats):
+                for name, make in (("dense", DenseLoopProblem), ("fast", local_sbt.LoopProblem)):
+                    wall, status, x, counts = run(make(g0, w, ops, local_sbt.make_workspace(n)),
+                                                  x0, args.t_end, options)
+                    best[name] = min(best[name], wall)
+                    result[name] = (status, x, counts)
+            counts = result["fast"][2]
+            row = dict(g0=g0, theta0=theta0, n=n, dense_s=best["dense"], fast_s=best["fast"],
+                       speedup=best["dense"] / best["fast"],
+                       counts_fast=[int(c) for c in counts],
+                       counts_dense=[int(c) for c in result["dense"][2]],
+                       max_dx=float(np.abs(result["fast"][1] - result["dense"][1]).max()),
+                       status=[result["fast"][0], result["dense"][0]])
+            rows.append(row)
+            print(f"{g0:>5g} {theta0:>4g} {n:>3} {row['dense_s']:>8.2f} {row['fast_s']:>8.2f} "
+                  f"{row['speedup']:>7.2f} {counts[2]:>7} {counts[3]:>5} {counts[4]:>5} "
+                  f"{counts[0] + counts[1]:>6} {row['max_dx']:>8.1e}", flush=True)
+    if args.out:
+        with open(args.out, "w") as handle:
+            json.dump(rows, handle, indent=1)
+
+
+if __name__ == "__main__":
+    main()
