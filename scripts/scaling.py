@@ -4,9 +4,10 @@ and whether the step is limited by stiffness or accuracy.
 Usage: python scripts/scaling.py [--orders 4,6,8,10,12,16] [--t-end 0.5]
 
 For each n (in-plane case g0 = 60, θ0 = 30°):
-* µs per RHS evaluation, split into the three maps (``compose_maps``), the
-  least-squares tension solve and the rest (velocity synthesis), each timed
-  in its own compiled loop;
+* µs per RHS evaluation, split into the maps (the affine map T -> ε of
+  ``local_sbt.length_rate_operator``, with the shape on the grid), the
+  least-squares tension solve (``linalg.least_squares_normal``) and the rest
+  (velocity synthesis), each timed in its own compiled loop;
 * one trajectory over t_end: steps, mean step against the stiffness bound
   3.7/λmax, λmax = 1.5 n²(n² − 1), and the share of wall time spent outside
   RHS evaluations (the stepper);
@@ -20,27 +21,21 @@ import numpy as np
 
 import loopsim
 from loopsim import shapes
-from loopsim.linalg import least_squares_affine
+from loopsim.linalg import least_squares_normal
 from loopsim.models import local_sbt as physics
 
 
 @numba.njit(cache=True)
 def _time_maps(x, g0, w, ops, ws, repeats):
     for _ in range(repeats):
-        physics.compose_maps(x, g0, w, ops, ws)
+        physics.shape_on_grid(x, ops, ws)
+        physics.length_rate_operator(g0, w, ops, ws)
 
 
 @numba.njit(cache=True)
-def _time_solve(block, ws, repeats):
-    for _ in range(repeats):
-        ws.length_rate[:] = block
-        least_squares_affine(ws.length_rate, ws.tension, ws.tau)
-
-
-@numba.njit(cache=True)
-def _time_copy(block, ws, repeats):
-    for _ in range(repeats):
-        ws.length_rate[:] = block
+def _time_solve(ops, ws, repeats):
+    for _ in range(repeats):  # the block is read, not destroyed
+        least_squares_normal(ws.length_rate, ops.column_scale, ws.tension, ws.gram)
 
 
 @numba.njit(cache=True)
@@ -78,9 +73,9 @@ def main():
         repeats = max(200, int(2e5 / n**3))
         rhs = per_call(_time_rhs, (x, g0, w, ops, ws, u), repeats)
         maps = per_call(_time_maps, (x, g0, w, ops, ws), repeats)
-        physics.compose_maps(x, g0, w, ops, ws)
-        block = ws.length_rate.copy()
-        solve = per_call(_time_solve, (block, ws), repeats) - per_call(_time_copy, (block, ws), repeats)
+        physics.shape_on_grid(x, ops, ws)
+        physics.length_rate_operator(g0, w, ops, ws)
+        solve = per_call(_time_solve, (ops, ws), repeats)
         result = loopsim.simulate(g0, 30.0, n=n, t_span=(0, args.t_end))
         stepper = 1 - result.nfev * rhs * 1e-6 / result.wall_s
         bound = 3.7 / (1.5 * n**2 * (n**2 - 1))
