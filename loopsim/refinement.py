@@ -18,6 +18,7 @@ is one call of ``integrators.integrate`` (one case) or ``batch.integrate_cases``
 import numpy as np
 
 from . import batch, integrators, models, spectral, validation
+from ._blas import one_blas_thread
 from .config import AUTO_ORDERS, DEFAULT_N
 from .integrators.control import REFINE
 
@@ -79,9 +80,11 @@ def integrate_case(method, g0, w, x0, t0, t_end, t_eval, options, ladder, tail_t
         x = spectral.resize(x, n)
         pending = np.flatnonzero(t_eval >= t if level == 0 else t_eval > t)
         y_out = np.full((pending.size, x.size), np.nan)
-        status, t, y, level_counts, level_worst = integrators.integrate(
-            method, models.local_sbt.make_problem(n, g0, w), x.ravel(), t, t_end,
-            t_eval[pending], level_options(options, tail_tol, level == len(ladder) - 1), y_out)
+        with one_blas_thread():
+            status, t, y, level_counts, level_worst = integrators.integrate(
+                method, models.local_sbt.make_problem(n, g0, w), x.ravel(), t, t_end,
+                t_eval[pending], level_options(options, tail_tol, level == len(ladder) - 1),
+                y_out)
         counts += level_counts
         worst = merge_worst(worst, level_worst)
         for row, i in enumerate(pending):
@@ -117,11 +120,12 @@ def integrate_cases(method, parameters, x0, t_end, options, ladder, tail_tol, co
         active = np.flatnonzero(status == REFINE)
         if not active.size:
             break
-        y_final, t_final, level_status, level_counts, level_worst = batch.integrate_cases(
-            method, models.local_sbt.make_operators(n), parameters[active],
-            np.array([spectral.resize(x[b], n).ravel() for b in active]), t_end[active],
-            level_options(options, tail_tol, level == len(ladder) - 1), cost=cost[active],
-            t0=t[active])
+        with one_blas_thread():  # the cases run in parallel already
+            y_final, t_final, level_status, level_counts, level_worst = batch.integrate_cases(
+                method, models.local_sbt.make_operators(n), parameters[active],
+                np.array([spectral.resize(x[b], n).ravel() for b in active]), t_end[active],
+                level_options(options, tail_tol, level == len(ladder) - 1),
+                cost=cost[active], t0=t[active])
         for row, b in enumerate(active):
             x[b] = y_final[row].reshape(3, -1)
             t[b] = t_final[row]

@@ -159,3 +159,36 @@ def test_auto_method_by_expected_regime():
     assert refinement.auto_method(5.0, 6, False) == "radau5"  # stable
     assert refinement.auto_method(20.0, 16, False) == "radau5"  # stiff at high n
     assert refinement.auto_method(20.0, 6, True) == "radau5"  # climbs
+
+
+def test_integrations_run_with_one_blas_thread(monkeypatch):
+    """Both entry points hold BLAS to one thread while the kernels run (the cases are
+    parallel already; loopsim._blas), and restore the user's setting afterwards."""
+    from threadpoolctl import threadpool_info, threadpool_limits
+
+    def blas_threads():
+        return {i["filepath"]: i["num_threads"] for i in threadpool_info()
+                if i["user_api"] == "blas"}
+
+    seen = []
+
+    def recording(real):
+        def wrapped(*args, **kwargs):
+            seen.append(blas_threads())
+            return real(*args, **kwargs)
+        return wrapped
+
+    monkeypatch.setattr(refinement.integrators, "integrate",
+                        recording(refinement.integrators.integrate))
+    monkeypatch.setattr(refinement.batch, "integrate_cases",
+                        recording(refinement.batch.integrate_cases))
+    x0 = shapes.start_shape(30.0, 4, 1e-3, 0)[0]
+    with threadpool_limits(limits=2, user_api="blas"):
+        before = blas_threads()
+        refinement.integrate_case(RADAU, 30.0, 10.0, x0, 0.0, 0.1, np.empty(0), _options(),
+                                  (4,), 1.0)
+        refinement.integrate_cases(RADAU, [(30.0, 10.0)], [x0], 0.1, _options(), (4,), 1.0)
+        after = blas_threads()
+    assert before and len(seen) == 2
+    assert all(set(s.values()) == {1} for s in seen)
+    assert after == before and set(before.values()) == {2}
