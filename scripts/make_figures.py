@@ -23,14 +23,20 @@ stated), so a rerun reproduces the tables.
 import argparse
 import os
 import shlex
+import signal
 import subprocess
 import sys
+import time
 
 import numpy as np
 import pandas as pd
 
 GRID = ["--g0", "10:350:15", "--theta0", "6:90:15"]
-RESOLVED = ["--method", "radau5", "--rtol", "1e-7", "--atol", "1e-10"]
+#: Resolved runs: automatic truncation (start at n = 6, climb the ladder 6, 8, 12, ... 32
+#: whenever the spectral tail passes the default --tail-tol 1e-5), integrator chosen per case.
+RESOLVED = ["--n", "auto", "--n-max", "32", "--method", "auto", "--rtol", "1e-7", "--atol", "1e-10"]
+#: A fixed-n check at n = 24 (radau5), not drawn: only with --n24.
+FIXED_N24 = ["--method", "radau5", "--rtol", "1e-7", "--atol", "1e-10"]
 
 
 def resolved_cases(path):
@@ -40,7 +46,8 @@ def resolved_cases(path):
     rows = [(g0, 30.0) for g0 in g]
     rows += [(g[i], 60.0) for i in (1, 2, 4, 6, 10)]
     rows += [(g[i], 84.0) for i in (1, 4, 8, 14)]
-    pd.DataFrame(rows, columns=["g0", "theta0_deg"]).assign(n=16, seed=0).to_csv(path, index=False)
+    # n: the start of the --n auto ladder (the n = 6 main job's initial curve, zero-padded)
+    pd.DataFrame(rows, columns=["g0", "theta0_deg"]).assign(n=6, seed=0).to_csv(path, index=False)
 
 
 def n24_cases(path):
@@ -49,46 +56,52 @@ def n24_cases(path):
     pd.DataFrame(rows, columns=["g0", "theta0_deg"]).assign(n=24, seed=0).to_csv(path, index=False)
 
 
-def steps(runs, threads):
-    """(output path, command) in order; a command is a list of loopsim arguments."""
+def steps(runs, threads, n24=False):
+    """(output path, command, capped) in order; a command is a list of loopsim arguments;
+    ``capped``: the resolved sweeps, which --max-wall may stop (they run one case per chunk
+    file, so every finished case is kept and a re-run resumes)."""
     t = ["--threads", str(threads), "--quiet"]
     fig = os.path.join(runs, "fig")
-    return [
-        (os.path.join(runs, "phase"), ["sweep", *GRID, "--out", os.path.join(runs, "phase"), *t]),
+    one = ["--chunk-size", "1"]
+    out = [
+        (os.path.join(runs, "phase"), ["sweep", *GRID, "--out", os.path.join(runs, "phase"), *t], False),
         (os.path.join(runs, "phase_n4"),
-         ["sweep", *GRID, "--n", "4", "--out", os.path.join(runs, "phase_n4"), *t]),
+         ["sweep", *GRID, "--n", "4", "--out", os.path.join(runs, "phase_n4"), *t], False),
         (os.path.join(runs, "phase_n8"),
-         ["sweep", *GRID, "--n", "8", "--method", "radau5", "--out", os.path.join(runs, "phase_n8"), *t]),
-        (os.path.join(runs, "resolved_n16"),
-         ["sweep", "--cases", os.path.join(fig, "resolved_cases.csv"), *RESOLVED,
-          "--out", os.path.join(runs, "resolved_n16"), *t]),
+         ["sweep", *GRID, "--n", "8", "--method", "radau5", "--out", os.path.join(runs, "phase_n8"),
+          *t], False),
+        (os.path.join(runs, "resolved_auto"),
+         ["sweep", "--cases", os.path.join(fig, "resolved_cases.csv"), *RESOLVED, *one,
+          "--out", os.path.join(runs, "resolved_auto"), *t], True),
         (os.path.join(runs, "seeds_n6"),
          ["sweep", "--g0", "150", "--theta0", "60", "--n", "6", "--seeds", "16",
-          "--out", os.path.join(runs, "seeds_n6"), *t]),
-        (os.path.join(runs, "seeds_n16"),
-         ["sweep", "--g0", "150", "--theta0", "60", "--n", "16", "--seeds", "12", *RESOLVED,
-          "--out", os.path.join(runs, "seeds_n16"), *t]),
+          "--out", os.path.join(runs, "seeds_n6"), *t], False),
+        (os.path.join(runs, "seeds_auto"),
+         ["sweep", "--g0", "150", "--theta0", "60", "--seeds", "12", *RESOLVED, *one,
+          "--out", os.path.join(runs, "seeds_auto"), *t], True),
         (os.path.join(fig, "g150_t60_n6.parquet"),
          ["run", "--g0", "150", "--theta0", "60", "--n", "6", "--t-end", "10", "--snapshots", "41",
-          "--out", os.path.join(fig, "g150_t60_n6.parquet")]),
+          "--out", os.path.join(fig, "g150_t60_n6.parquet")], False),
         (os.path.join(fig, "g150_t60_n16.parquet"),
          ["run", "--g0", "150", "--theta0", "60", "--n", "16", "--method", "radau5", "--t-end", "2",
-          "--snapshots", "41", "--out", os.path.join(fig, "g150_t60_n16.parquet")]),
+          "--snapshots", "41", "--out", os.path.join(fig, "g150_t60_n16.parquet")], False),
         (os.path.join(fig, "g60_t30_n16.parquet"),
          ["run", "--g0", "60", "--theta0", "30", "--n", "16", "--method", "radau5", "--t-end", "10",
-          "--snapshots", "21", "--out", os.path.join(fig, "g60_t30_n16.parquet")]),
-        (os.path.join(runs, "resolved_n24"),
-         ["sweep", "--cases", os.path.join(fig, "n24_cases.csv"), *RESOLVED,
-          "--out", os.path.join(runs, "resolved_n24"), *t]),
+          "--snapshots", "21", "--out", os.path.join(fig, "g60_t30_n16.parquet")], False),
     ]
+    if n24:
+        out.append((os.path.join(runs, "resolved_n24"),
+                    ["sweep", "--cases", os.path.join(fig, "n24_cases.csv"), *FIXED_N24, *one,
+                     "--out", os.path.join(runs, "resolved_n24"), *t], True))
+    return out
 
 
 def figure_commands(runs, out):
     """Two ``loopsim figures`` calls: everything but the tension colouring (3D runs for
     Fig. 6), then the tension colouring of the in-plane loop only."""
     fig = os.path.join(runs, "fig")
-    sweeps = [os.path.join(runs, d) for d in ("phase", "phase_n4", "phase_n8", "resolved_n16",
-                                              "seeds_n6", "seeds_n16")]
+    sweeps = [os.path.join(runs, d) for d in ("phase", "phase_n4", "phase_n8", "resolved_auto",
+                                              "seeds_n6", "seeds_auto")]
     evolution = [os.path.join(fig, f) for f in ("g150_t60_n6.parquet", "g150_t60_n16.parquet")]
     return [
         ["figures", *sweeps, *evolution, "--out", out, "--only",
@@ -98,14 +111,28 @@ def figure_commands(runs, out):
     ]
 
 
-def loopsim(args, dry_run):
+def loopsim(args, dry_run, max_wall=None):
+    """Run ``python -m loopsim ARGS``; ``max_wall``: seconds after which a sweep gets
+    SIGTERM (it keeps its finished cases and exits 143; the figures use those)."""
     command = [sys.executable, "-m", "loopsim", *args]
-    print("$ " + " ".join(shlex.quote(a) for a in command), flush=True)
+    print("$ " + " ".join(shlex.quote(a) for a in command)
+          + (f"    # stopped after {max_wall:g} s" if max_wall else ""), flush=True)
     if dry_run:
         return
-    code = subprocess.run(command).returncode
+    start = time.monotonic()
+    process = subprocess.Popen(command)
+    try:
+        code = process.wait(timeout=max_wall)
+    except subprocess.TimeoutExpired:
+        process.send_signal(signal.SIGTERM)
+        code = process.wait()
+    wall = time.monotonic() - start
+    print(f"# wall {wall:.0f} s, exit status {code}", flush=True)
     if code == 1 and args[0] == "sweep":  # some case failed: it is a row with its status
         print("# some cases failed (see their 'status'); going on", flush=True)
+    elif code == 143 and max_wall and args[0] == "sweep":
+        print(f"# stopped at the {max_wall:g} s cap: finished cases kept (re-run to resume)",
+              flush=True)
     elif code != 0:
         sys.exit(f"make_figures: '{' '.join(args[:2])} ...' exited with status {code}")
 
@@ -115,18 +142,25 @@ def main():
     parser.add_argument("--runs", default="runs", help="where the runs go (gitignored)")
     parser.add_argument("--out", default=os.path.join("docs", "figures"))
     parser.add_argument("--threads", type=int, default=os.cpu_count() or 1)
+    parser.add_argument("--max-wall", type=float, default=None, metavar="SECONDS",
+                        help="stop each resolved sweep (--n auto, and --n24) after this many "
+                             "seconds and draw from the cases it finished (default: no cap)")
+    parser.add_argument("--n24", action="store_true",
+                        help="also run the fixed n = 24 check (4 cases, not drawn)")
     parser.add_argument("--dry-run", action="store_true", help="print the commands only")
     args = parser.parse_args()
+    if args.max_wall is not None and args.max_wall <= 0:
+        parser.error("--max-wall must be positive")
     fig = os.path.join(args.runs, "fig")
     os.makedirs(fig, exist_ok=True)
     resolved_cases(os.path.join(fig, "resolved_cases.csv"))
     n24_cases(os.path.join(fig, "n24_cases.csv"))
-    for output, command in steps(args.runs, args.threads):
+    for output, command, capped in steps(args.runs, args.threads, args.n24):
         # a sweep resumes by itself; a finished run file is kept
         if command[0] == "run" and os.path.exists(output):
             print(f"# {output} exists, kept")
             continue
-        loopsim(command, args.dry_run)
+        loopsim(command, args.dry_run, args.max_wall if capped else None)
     for command in figure_commands(args.runs, args.out):
         loopsim(command, args.dry_run)
 
