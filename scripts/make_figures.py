@@ -116,7 +116,7 @@ def loopsim(args, dry_run, max_wall=None):
     SIGTERM (it keeps its finished cases and exits 143; the figures use those)."""
     command = [sys.executable, "-m", "loopsim", *args]
     print("$ " + " ".join(shlex.quote(a) for a in command)
-          + (f"    # stopped after {max_wall:g} s" if max_wall else ""), flush=True)
+          + (f"    # capped at {max_wall:g} s" if max_wall else ""), flush=True)
     if dry_run:
         return
     start = time.monotonic()
