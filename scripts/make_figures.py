@@ -31,6 +31,8 @@ import time
 import numpy as np
 import pandas as pd
 
+from loopsim.io import case_order
+
 GRID = ["--g0", "10:350:15", "--theta0", "6:90:15"]
 #: Resolved runs: automatic truncation (start at n = 6, climb the ladder 6, 8, 12, ... 32
 #: whenever the spectral tail passes the default --tail-tol 1e-5), integrator chosen per case.
@@ -41,13 +43,19 @@ FIXED_N24 = ["--method", "radau5", "--rtol", "1e-7", "--atol", "1e-10"]
 
 def resolved_cases(path):
     """The 24 representative cases (the main grid's g0 values): θ0 = 30° across g0,
-    five at θ0 = 60° and four at 84°."""
+    five at θ0 = 60° and four at 84°.  Written so that the sweep runs them in order of
+    increasing q0 (cost grows steeply with q0): the sweep's k-th chunk of one case is
+    case ``case_order(24)[k]``, so a --max-wall cap drops the highest-q0 cases first."""
     g = np.linspace(10, 350, 15)
     rows = [(g0, 30.0) for g0 in g]
     rows += [(g[i], 60.0) for i in (1, 2, 4, 6, 10)]
     rows += [(g[i], 84.0) for i in (1, 4, 8, 14)]
+    rows.sort(key=lambda r: r[0] * np.sin(np.radians(r[1])))
+    table = [None] * len(rows)
+    for k, case_id in enumerate(case_order(len(rows))):
+        table[case_id] = rows[k]
     # n: the start of the --n auto ladder (the n = 6 main job's initial curve, zero-padded)
-    pd.DataFrame(rows, columns=["g0", "theta0_deg"]).assign(n=6, seed=0).to_csv(path, index=False)
+    pd.DataFrame(table, columns=["g0", "theta0_deg"]).assign(n=6, seed=0).to_csv(path, index=False)
 
 
 def n24_cases(path):
