@@ -1,21 +1,43 @@
 """Regenerate the figure suite of docs/figures/ (the paper's figures and their corrections).
 
 Usage: python scripts/make_figures.py [--runs runs] [--out docs/figures] [--threads T]
-                                      [--dry-run]
+                                      [--max-wall SECONDS] [--n24] [--dry-run]
 
 Runs what the figures need into --runs (gitignored; each step is skipped when its
 output exists, and an interrupted sweep resumes), then draws everything with
-``loopsim figures`` (loopsim/figures.py).  The steps, with their cost measured on
-a shared 2-core machine in this project (other jobs running):
+``loopsim figures`` (loopsim/figures.py).  The steps:
 
-1. the main job, 225 loops at n = 6 (README): a few minutes;
+1. the main job, 225 loops at n = 6 (rkf45, the README's);
 2. the same grid at n = 4 (rkf45) and n = 8 (radau5): the paper's Fig. 9;
-3. 24 representative cases at n = 16 (radau5, rtol 1e-7): the resolved reference
-   drawn over Figs. 7 and 8 and its own gallery (θ0 = 30°);
-4. g0 = 150, θ0 = 60°: 16 seeds at n = 6 and 12 at n = 16 (seed distributions),
-   one trajectory at n = 6 and n = 16 with snapshots (Fig. 6), and an in-plane loop
-   (g0 = 60, θ0 = 30°, n = 16) for the tension colouring (Fig. 1);
-5. 4 cases at n = 24: the convergence check of docs/paper-comparison.md (not drawn).
+3. 24 representative cases (θ0 = 30° across the grid's g0, five at 60°, four at 84°)
+   with automatic truncation: ``--n auto --n-max 32 --method auto --rtol 1e-7
+   --atol 1e-10`` (each starts at n = 6 from the main job's curve and climbs the
+   ladder 6, 8, 12, ... 32 whenever its spectral tail passes the default --tail-tol
+   1e-5; rows carry n_used, tail_max, resolved).  The resolved reference, drawn over
+   Figs. 7 and 8 and as its own gallery (θ0 = 30°).  Run cheapest first (increasing
+   q0), one case per chunk file, so a --max-wall cap keeps every finished case and
+   drops the highest-q0 ones;
+4. g0 = 150, θ0 = 60°: 16 seeds at n = 6 and 12 seeds with the settings of step 3
+   (seed distributions); one trajectory at n = 6 and at fixed n = 16 (radau5, t = 2,
+   kept: one fixed order makes a trajectory's snapshots comparable) with snapshots
+   (Fig. 6), and an in-plane loop (g0 = 60, θ0 = 30°, n = 16) for the tension
+   colouring (Fig. 1);
+5. only with --n24: 4 cases at fixed n = 24 (radau5, rtol 1e-7), a check not drawn
+   (--n auto's own tail criterion now says which rows are resolved; see README,
+   "Automatic truncation", for its check against n_used + 8).
+
+What was run for the committed figures (December 2026; a shared 2-core machine, one
+thread, ``nice -n 10``, another engineer's benchmark on the other core):
+``python scripts/make_figures.py --runs runs --out docs/figures --threads 1
+--max-wall 1500``, after steps 1-2 had been run with the same commands.  Wall times:
+step 1 379 s; n = 4 135 s (1 of 225 cases failed: length error); n = 8 617 s;
+step 3 stopped at the 1500 s cap with 20 of the 24 cases done (n_used 12: 5,
+16: 5, 20: 3, 24: 4, 32: 3; 18 resolved, the other two at n_max = 32 with tail_max
+1.6e-5 and 1.7e-5); the four not run are the highest q0 (58.3, 67.7, 73.0, 116.0).
+Cost grows steeply with q0 (column wall_s): q0 <= 30.9 at most 3.3 s per case,
+q0 = 34-45 2.6-40 s, q0 = 46.2, 50.2, 54.3 (n_used 32) 304, 361 and 507 s.  rtol 1e-7
+was kept; 1e-6 was not tried.
+WALL_SEEDS.  Figures: WALL_FIGURES.
 
 Nothing here is random beyond the seeded initial perturbations (seed 0 unless
 stated), so a rerun reproduces the tables.
