@@ -646,8 +646,9 @@ def write_figures(sweep_dir, others=(), out=".", only=None, gallery_theta0=30.0,
         save("seed_distributions", seed_distributions(frames, [_label(f) for f in frames]))
     for path, trajectory, summary in runs:
         stem = os.path.splitext(os.path.basename(path))[0]
-        title = (f"g0 = {summary['g0']:g}, θ0 = {summary['theta0_deg']:.3g}°, "
-                 f"n = {summary['n']}")
+        used = summary.get("n_used", summary["n"])
+        order = f"n = {summary['n']}" if used == summary["n"] else f"n auto (n_used = {used})"
+        title = f"g0 = {summary['g0']:g}, θ0 = {summary['theta0_deg']:.3g}°, {order}"
         if "evolution" in only:
             save(f"fig6_evolution_{stem}", evolution(trajectory, title=title))
         if "tension" in only:
