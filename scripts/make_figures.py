@@ -19,7 +19,7 @@ output exists, and an interrupted sweep resumes), then draws everything with
    drops the highest-q0 ones;
 4. g0 = 150, θ0 = 60°: 16 seeds at n = 6 and 12 seeds with the settings of step 3
    (seed distributions); one trajectory at n = 6 and at fixed n = 16 (radau5, t = 2,
-   kept: one fixed order makes a trajectory's snapshots comparable) with snapshots
+   kept from the earlier suite) with snapshots
    (Fig. 6), the same start with the settings of step 3 (t = 10: the fixed n = 16 run
    fails the `resolved` test, its spectral tail reaching 5.8e-5; this one ends at
    n_used 20, resolved), and an in-plane loop (g0 = 60, θ0 = 30°, n = 16) for the tension
@@ -31,7 +31,9 @@ output exists, and an interrupted sweep resumes), then draws everything with
 What was run for the committed figures (December 2026; a shared 2-core machine, one
 thread, ``nice -n 10``, another engineer's benchmark on the other core):
 ``python scripts/make_figures.py --runs runs --out docs/figures --threads 1
---max-wall 1500``, after steps 1-2 had been run with the same commands.  Wall times:
+--max-wall 1500``, after steps 1-2 had been run with the same commands (the script
+then found them complete in 3-5 s each; a first start of step 3 in the grid's order,
+stopped after 10 min with 7 cases, was set aside and the cases reordered).  Wall times:
 step 1 379 s; n = 4 135 s (1 of 225 cases failed: length error); n = 8 617 s;
 step 3 stopped at the 1500 s cap with 20 of the 24 cases done (n_used 12: 5,
 16: 5, 20: 3, 24: 4, 32: 3; 18 resolved, the other two at n_max = 32 with tail_max
@@ -40,7 +42,10 @@ Cost grows steeply with q0 (column wall_s): q0 <= 30.9 at most 3.3 s per case,
 q0 = 34-45 2.6-40 s, q0 = 46.2, 50.2, 54.3 (n_used 32) 304, 361 and 507 s.  rtol 1e-7
 was kept; 1e-6 was not tried.
 Step 4: seeds at n = 6 16 s; the 12 --n auto seeds 139 s (all resolved; n_used 20: 7,
-24: 5); the runs 5 s (n = 6), WALL_RUNS.  Figures: WALL_FIGURES.
+24: 5); the runs 5 s (n = 6), n = 16 8 s, the in-plane n = 16 run 7 s; the pipeline
+took 1716 s in all.  The --n auto trajectory was added afterwards and run alone with
+its step's command (12 s; n_used 20, tail_max 4.4e-6), then the two ``loopsim figures``
+commands below were re-run (17 s and 6 s).
 
 Nothing here is random beyond the seeded initial perturbations (seed 0 unless
 stated), so a rerun reproduces the tables.
