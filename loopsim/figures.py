@@ -67,6 +67,21 @@ def centred_curve(x, points=CURVE_POINTS):
     return spectral.evaluate(x, s)
 
 
+def order_column(frame):
+    """The column holding each row's truncation order: ``n_used`` (the order its terminal
+    coefficients are at; with ``--n auto`` the highest reached) when present, else ``n``."""
+    return "n_used" if "n_used" in frame and frame["n_used"].notna().all() else "n"
+
+
+def orders_text(frame):
+    """'n = 6' for a fixed-n table, 'n auto (n_used = 12, 16)' for ``--n auto`` rows."""
+    column = order_column(frame)
+    values = ", ".join(str(int(v)) for v in sorted(frame[column].unique()))
+    config = (frame.attrs.get("loopsim", {}) or {}).get("sweep_config", {}) or {}
+    auto = bool(config.get("n_auto")) or (column == "n_used" and bool((frame["n_used"] != frame["n"]).any()))
+    return f"n auto (n_used = {values})" if auto else f"n = {values}"
+
+
 def _regime_style(regime):
     return REGIME_STYLE.get(regime, REGIME_STYLE["failed"])
 
@@ -211,7 +226,7 @@ def gallery(frame, theta0_deg=30.0, max_shapes=8, axes=None):
     resolved = _resolved(rows)
     t0 = np.radians(chosen)
     for i, (_, row) in enumerate(rows.iterrows()):
-        x = coefficients(row["x_final"], row["n"])
+        x = coefficients(row["x_final"], row[order_column(rows)])
         colour = _regime_style(row["regime"])["color"]
         h, p = _side_view_basis(x)
         points = centred_curve(x)
@@ -240,8 +255,8 @@ def gallery(frame, theta0_deg=30.0, max_shapes=8, axes=None):
             spine.set_linewidth(0.4)
     top[0].set_ylabel("side view", fontsize=8)
     bottom[0].set_ylabel("in its plane", fontsize=8)
-    orders = ", ".join(str(v) for v in sorted(rows["n"].unique()))
-    fig.suptitle(f"terminal shapes, θ0 = {chosen:g}°, n = {orders} (colour: regime)", fontsize=9)
+    fig.suptitle(f"terminal shapes, θ0 = {chosen:g}°, {orders_text(rows)} (colour: regime)",
+                 fontsize=9)
     return fig
 
 
@@ -393,7 +408,7 @@ def q_and_tilt(frame, thresholds=None, axes=None, reference=None):
         if reference is not None and len(reference):
             ax.scatter(reference[xcol], reference[ycol], marker="D", s=26, facecolors="none",
                        edgecolors="k", linewidths=0.9, zorder=4,
-                       label=f"n = {', '.join(map(str, sorted(reference['n'].unique())))} (reference)")
+                       label=f"{orders_text(reference)} (reference)")
     left.set(xlabel=r"initial $q_0 = g_0 \sin\theta_0 / 3$", ylabel=r"terminal $q = g_0 \sin\theta / 3$",
              xlim=(0, q_max), ylim=(0, q_max))
     right.set(xlabel=r"initial tilt $\theta_0$ (deg)", ylabel=r"terminal tilt $\theta$ (deg)",
@@ -419,7 +434,7 @@ def aspect_ratio(frame, branch=None, ax=None, reference=None, q_max=None):
     if reference is not None and len(reference):
         ax.scatter(reference["q_final"], reference["aspect_ratio"], marker="D", s=26,
                    facecolors="none", edgecolors="k", linewidths=0.9, zorder=4,
-                   label=f"n = {', '.join(map(str, sorted(reference['n'].unique())))} (reference)")
+                   label=f"{orders_text(reference)} (reference)")
     if branch is not None and len(branch):
         stable = (branch["stable_in_plane"].to_numpy(bool)
                   & branch["stable_out_of_plane"].to_numpy(bool))
@@ -545,10 +560,9 @@ def _kind(frame):
 
 
 def _label(frame):
-    orders = ", ".join(str(v) for v in sorted(frame["n"].unique()))
-    method = frame["method"].iloc[0] if "method" in frame else (
-        frame.attrs.get("loopsim", {}).get("sweep_config", {}) or {}).get("method")
-    return f"n = {orders}" + (f", {method}" if method else "")
+    method = ("/".join(sorted(map(str, frame["method"].dropna().unique()))) if "method" in frame
+              else (frame.attrs.get("loopsim", {}).get("sweep_config", {}) or {}).get("method"))
+    return orders_text(frame) + (f", {method}" if method else "")
 
 
 def load_branch(n=12, q_max=25.0):
@@ -632,8 +646,9 @@ def write_figures(sweep_dir, others=(), out=".", only=None, gallery_theta0=30.0,
         save("seed_distributions", seed_distributions(frames, [_label(f) for f in frames]))
     for path, trajectory, summary in runs:
         stem = os.path.splitext(os.path.basename(path))[0]
-        title = (f"g0 = {summary['g0']:g}, θ0 = {summary['theta0_deg']:.3g}°, "
-                 f"n = {summary['n']}")
+        used = summary.get("n_used", summary["n"])
+        order = f"n = {summary['n']}" if used == summary["n"] else f"n auto (n_used = {used})"
+        title = f"g0 = {summary['g0']:g}, θ0 = {summary['theta0_deg']:.3g}°, {order}"
         if "evolution" in only:
             save(f"fig6_evolution_{stem}", evolution(trajectory, title=title))
         if "tension" in only:

@@ -3,8 +3,9 @@
 Usage: python scripts/paper_comparison.py [--runs runs]
 
 Reads (through ``loopsim.read_results``) the main job at n = 6 (runs/phase), the
-same grid at n = 4 and n = 8, the representative cases at n = 16 and n = 24 and
-the seed ensembles, and prints, per claim of the paper, the measured counts and
+same grid at n = 4 and n = 8, the 24 representative cases with --n auto
+(runs/resolved_auto; runs/resolved_n24 at fixed n = 24 when run with --n24) and the
+seed ensembles (n = 6, --n auto), and prints, per claim of the paper, the measured counts and
 ranges.  Missing tables are skipped with a note.
 """
 import argparse
@@ -31,8 +32,13 @@ def regimes(frame):
 
 
 def describe(name, f):
-    print(f"\n## {name}: {len(f)} cases, n = {sorted(f['n'].unique())}: {regimes(f)}; "
-          f"resolved {int(f['resolved'].sum())}; steady before t_end {int((f['stop_reason'] == 'steady').sum())}")
+    used = ", ".join(f"{int(k)}: {v}" for k, v in sorted(f["n_used"].value_counts().items()))
+    print(f"\n## {name}: {len(f)} cases, n = {sorted(int(v) for v in f['n'].unique())}, n_used {{{used}}}: "
+          f"{regimes(f)}; resolved {int(f['resolved'].sum())}; "
+          f"steady before t_end {int((f['stop_reason'] == 'steady').sum())}")
+    print(f"methods {dict((str(k), int(v)) for k, v in f['method'].value_counts().items())}; tail_max largest {f['tail_max'].max():.2g}; "
+          f"length_error_max largest {f['length_error_max'].max():.2g}; wall_s total "
+          f"{f['wall_s'].sum():.0f}, largest {f['wall_s'].max():.0f}")
     stable, inplane, d3 = (f[f["regime"] == r] for r in ("stable", "in-plane", "3d"))
     if len(stable):
         print(f"settling angle, stable: max {stable['settling_angle_deg'].max():.4f} deg")
@@ -55,9 +61,21 @@ def describe(name, f):
         print(f"3d: terminal tilt quartiles {np.round(d3['theta_final_deg'].quantile([.25, .5, .75]).to_numpy(), 1)}"
               f", aspect ratio quartiles {np.round(d3['aspect_ratio'].quantile([.25, .5, .75]).to_numpy(), 3)}"
               f", terminal q > 18.5 in {int((d3['q_final'] > 18.5).sum())}")
+    band = f[(f["q0"] > 10.5) & (f["q0"] < 18.5)]
+    if len(band):
+        print(f"inside 10.5 < q0 < 18.5: {len(band)} cases, {regimes(band)}")
+    if len(inplane):
+        print("in-plane q0: " + ", ".join(f"{q:.2f}" for q in sorted(inplane["q0"])))
+    if len(d3):
+        print(f"3d: terminal q from {d3['q_final'].min():.2f} to {d3['q_final'].max():.1f}; "
+              f"not resolved {int((~d3['resolved']).sum())} of {len(d3)}; length_error_max median "
+              f"{d3['length_error_max'].median():.2g}, largest {d3['length_error_max'].max():.2g}; "
+              f"still changing at t_end {int((d3['stop_reason'] == 't_end').sum())}")
+    print(f"still changing at t_end: {int((f['stop_reason'] == 't_end').sum())} of {len(f)}")
     low = f[f["q_final"] < Q_STAR]
     if len(low):
-        print(f"terminal q < {Q_STAR}: {len(low)} cases, aspect ratio > 1.01 in "
+        print(f"terminal q < {Q_STAR}: {len(low)} cases, aspect ratio <= 1.01 in "
+              f"{int((low['aspect_ratio'] <= 1.01).sum())}, > 1.01 in "
               f"{int((low['aspect_ratio'] > 1.01).sum())} (of them steady: "
               f"{int(((low['aspect_ratio'] > 1.01) & (low['stop_reason'] == 'steady')).sum())})")
 
@@ -69,11 +87,15 @@ def pairs(low, high, label):
     if not len(merged):
         return
     print(f"\n## {label}")
-    print("| g0 | θ0 | q0 | regime (low / high) | tilt (low / high) | aspect ratio (low / high) |")
+    print("| g0 | θ0 | q0 | n_used (low / high) | regime (low / high) | tilt (low / high) | "
+          "aspect ratio (low / high) | resolved (low / high) | tail_max (high) | wall s (high) |")
     for _, r in merged.iterrows():
-        print(f"| {r['g0']:.1f} | {r['theta0_deg']:g} | {r['q0']:.1f} | {r['regime_low']} / {r['regime']} | "
+        print(f"| {r['g0']:.1f} | {r['theta0_deg']:g} | {r['q0']:.1f} | {r['n_used_low']} / {r['n_used']} | "
+              f"{r['regime_low']} / {r['regime']} | "
               f"{r['theta_final_deg_low']:.1f} / {r['theta_final_deg']:.1f} | "
-              f"{r['aspect_ratio_low']:.3f} / {r['aspect_ratio']:.3f} |")
+              f"{r['aspect_ratio_low']:.3f} / {r['aspect_ratio']:.3f} | "
+              f"{'yes' if r['resolved_low'] else 'no'} / {'yes' if r['resolved'] else 'no'} | "
+              f"{r['tail_max']:.1e} | {r['wall_s']:.0f} |")
 
 
 def main():
@@ -81,14 +103,14 @@ def main():
     parser.add_argument("--runs", default="runs")
     args = parser.parse_args()
     tables = {name: load(args.runs, name) for name in
-              ("phase", "phase_n4", "phase_n8", "resolved_n16", "resolved_n24", "seeds_n6", "seeds_n16")}
+              ("phase", "phase_n4", "phase_n8", "resolved_auto", "resolved_n24", "seeds_n6", "seeds_auto")}
     for name, frame in tables.items():
         if frame is not None and len(frame):
             describe(name, frame)
-    if tables["phase"] is not None and tables["resolved_n16"] is not None:
-        pairs(tables["phase"], tables["resolved_n16"], "n = 6 (main job) against n = 16")
-    if tables["resolved_n16"] is not None and tables["resolved_n24"] is not None:
-        pairs(tables["resolved_n16"], tables["resolved_n24"], "n = 16 against n = 24")
+    if tables["phase"] is not None and tables["resolved_auto"] is not None:
+        pairs(tables["phase"], tables["resolved_auto"], "n = 6 (main job) against --n auto")
+    if tables["resolved_auto"] is not None and tables["resolved_n24"] is not None:
+        pairs(tables["resolved_auto"], tables["resolved_n24"], "--n auto against n = 24")
 
 
 if __name__ == "__main__":

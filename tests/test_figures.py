@@ -112,6 +112,27 @@ def test_gallery_draws_side_and_plane_views_in_regime_colours():
     assert np.degrees(np.arctan2(np.ptp(z), np.ptp(y))) == pytest.approx(30.0, abs=0.5)
 
 
+def auto_table():
+    """Rows as --n auto writes them: n the ladder's start (N), terminal coefficients at n_used."""
+    frame = table(8)
+    used = np.where(np.arange(len(frame)) % 2, N + 2, N)
+    frame["n_used"] = used
+    frame["x_final"] = [ellipse(t, 1.3, n=int(k)).ravel().tolist()
+                        for t, k in zip(frame["theta_final_deg"], used)]
+    return frame
+
+
+def test_figures_of_n_auto_rows_read_the_coefficients_at_n_used():
+    frame = auto_table()
+    assert figures.order_column(frame) == "n_used"
+    assert figures.orders_text(frame) == f"n auto (n_used = {N}, {N + 2})"
+    assert figures.orders_text(table()) == f"n = {N}"
+    fig = figures.gallery(frame, theta0_deg=30.0)  # coefficients at n_used, not at n
+    assert "n auto (n_used = " in fig._suptitle.get_text()
+    fig = figures.aspect_ratio(table(), reference=frame)
+    assert any("n auto" in text.get_text() for text in fig.axes[0].get_legend().get_texts())
+
+
 def test_phase_diagram_paper_band_adds_the_two_empirical_curves():
     frame = table()
     plain = plots.phase_diagram(frame)
