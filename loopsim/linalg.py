@@ -139,11 +139,12 @@ def _cholesky_solve(factor, rhs):
 
 
 @numba.njit(**JIT)
-def _scaled_normal_residual(block, scale, tau, out):
-    """out = −D Aᵀ (A τ + b): the normal equations' residual in the scaled unknowns."""
+def _scaled_normal_residual(block, scale, tau, residual, out):
+    """out = −D Aᵀ (A τ + b): the normal equations' residual in the scaled unknowns
+    (``residual`` (M,) scratch: A τ + b)."""
     k = block.shape[0] - 1
     m = block.shape[1]
-    residual = block[k].copy()
+    residual[:] = block[k]
     for j in range(k):
         for p in range(m):
             residual[p] += block[j, p] * tau[j]
@@ -155,13 +156,14 @@ def _scaled_normal_residual(block, scale, tau, out):
 
 
 @numba.njit(**JIT)
-def least_squares_normal(block, scale, out, gram):
+def least_squares_normal(block, scale, out, gram, residual, correction):
     """Solve min_τ ||A τ + b||₂ (block as in :func:`least_squares_affine`, not destroyed)
     by Björck's corrected semi-normal equations on the column-scaled problem:
 
         (D Aᵀ A D) y = −D Aᵀ b,   τ = D y,   D = diag(scale),
 
-    by LAPACK's Cholesky (potrf, in ``gram`` (K, K)), then one refinement step with
+    by LAPACK's Cholesky (potrf, in ``gram`` (K, K); ``residual`` (M,) and ``correction``
+    (K,) are scratch), then one refinement step with
     the residual −D Aᵀ(A τ + b) of the normal equations.  The step restores QR's
     accuracy while cond(A D) ≪ 1/√eps (``models.local_sbt``: cond(A D) ≈ 20 on run
     shapes, 2·10³ on a strongly stretched one).  Returns potrf's info: 0, or k > 0
@@ -180,9 +182,8 @@ def least_squares_normal(block, scale, out, gram):
     if info != 0:
         return info
     out[:] = 0.0
-    correction = np.empty(k)
     for _ in range(2):  # the solve, then one refinement step
-        _scaled_normal_residual(block, scale, out, correction)
+        _scaled_normal_residual(block, scale, out, residual, correction)
         _cholesky_solve(gram, correction)
         for i in range(k):
             out[i] += scale[i] * correction[i]

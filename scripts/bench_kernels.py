@@ -18,7 +18,6 @@ Run it alone with OPENBLAS_NUM_THREADS=1: the ratios come from one run.
 """
 import argparse
 import json
-import time
 
 import numba
 import numpy as np
@@ -27,6 +26,7 @@ import loopsim
 from loopsim import linalg, spectral
 from loopsim.integrators import radau
 from loopsim.models import local_sbt
+from scaling import per_call  # best of three timed loops, µs per call
 
 
 @numba.njit(cache=True)
@@ -51,17 +51,6 @@ def _jacobian(x, g0, w, ops, ws, jac, repeats):
 def _newton_lu(jac, lu_real, piv_real, lu_complex, piv_complex, repeats):
     for _ in range(repeats):
         radau.newton_matrices(jac, 0.01, lu_real, piv_real, lu_complex, piv_complex)
-
-
-def per_call(fn, args, repeats):
-    """Best of three timed loops, µs per call."""
-    fn(*args, 1)
-    best = np.inf
-    for _ in range(3):
-        start = time.perf_counter()
-        fn(*args, repeats)
-        best = min(best, time.perf_counter() - start)
-    return 1e6 * best / repeats
 
 
 def main():

@@ -35,7 +35,8 @@ def _time_maps(x, g0, w, ops, ws, repeats):
 @numba.njit(cache=True)
 def _time_solve(ops, ws, repeats):
     for _ in range(repeats):  # the block is read, not destroyed
-        least_squares_normal(ws.length_rate, ops.column_scale, ws.tension, ws.gram)
+        least_squares_normal(ws.length_rate, ops.column_scale, ws.tension, ws.gram,
+                             ws.residual, ws.correction)
 
 
 @numba.njit(cache=True)

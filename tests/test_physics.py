@@ -121,7 +121,8 @@ def test_normal_equations_agree_with_qr_on_the_tension_map(n, rng):
     assert np.linalg.cond(a * ops.column_scale) < 1e4
     k = 2 * n + 1
     normal, qr = np.empty(k), np.empty(k)
-    assert least_squares_normal(ws.length_rate, ops.column_scale, normal, np.empty((k, k))) == 0
+    assert least_squares_normal(ws.length_rate, ops.column_scale, normal, np.empty((k, k)),
+                                np.empty(ops.m), np.empty(k)) == 0
     least_squares_affine(ws.length_rate, qr, np.empty(k))
     np.testing.assert_allclose(normal, qr, rtol=0, atol=1e-10 * np.abs(qr).max())
 
@@ -133,10 +134,12 @@ def test_normal_equations_match_numpy_and_refuse_indefinite(rng):
     block = np.ascontiguousarray(np.column_stack([a, b]).T)
     out = np.empty(10)
     scale = 1.0 / (1.0 + np.arange(10) ** 2)
-    assert least_squares_normal(block, scale, out, np.empty((10, 10))) == 0
+    assert least_squares_normal(block, scale, out, np.empty((10, 10)), np.empty(41),
+                                np.empty(10)) == 0
     np.testing.assert_allclose(out, np.linalg.lstsq(a, -b, rcond=None)[0], rtol=1e-11)
     block[3] = 0.0  # a zero column
-    assert least_squares_normal(block, scale, out, np.empty((10, 10))) > 0
+    assert least_squares_normal(block, scale, out, np.empty((10, 10)), np.empty(41),
+                                np.empty(10)) > 0
 
 
 def _rotate_z(x, phi):

@@ -67,12 +67,13 @@ LoopOperators = collections.namedtuple(
 #: the column of T = φ_j; row K: the affine part), as LAPACK's QR wants it; ``tau``
 #: is the QR's scratch.
 #: The fast path's scratch: ``coupling`` (2M, M) holds Bᵀ over B₂ᵀ (tension_operator),
-#: ``partial`` (K, M) is S0ᵀ Bᵀ, ``fields`` (3, 3, M) grid fields, ``gram`` (K, K) the
-#: normal equations.
+#: ``partial`` and ``columns`` (K, M) are S0ᵀ Bᵀ and S0ᵀ Bᵀ Bᵀ, ``fields`` (3, 3, M) and
+#: ``grid_force`` (3, M) grid fields, ``tension_grid`` (M,), and ``gram`` (K, K),
+#: ``residual`` (M,), ``correction`` (K,) the normal equations' (linalg.least_squares_normal).
 Workspace = collections.namedtuple(
     "Workspace",
     "tangent curvature x4 raw force mobile dmobile length_rate velocity tension tau "
-    "coupling partial fields gram"
+    "coupling partial columns fields grid_force tension_grid gram residual correction"
 )
 
 
@@ -104,8 +105,9 @@ def make_workspace(n):
         np.empty((3, m)), np.empty((3, m)), np.empty((3, m)),
         np.empty((m, 3, k + 1)), np.empty((m, 3, k + 1)), np.empty((m, 3, k + 1)),
         np.empty((m, 3, k + 1)), np.empty((k + 1, m)), np.empty((3, m)), np.empty(k),
-        np.empty(k), np.empty((2 * m, m)), np.empty((k, m)), np.empty((3, 3, m)),
-        np.empty((k, k)),
+        np.empty(k), np.empty((2 * m, m)), np.empty((k, m)), np.empty((k, m)),
+        np.empty((3, 3, m)), np.empty((3, m)), np.empty(m), np.empty((k, k)), np.empty(m),
+        np.empty(k),
     )
 
 
@@ -200,7 +202,7 @@ def length_rate_operator(g0, w, ops, ws):
     A = (B₂ + B B) S0 (stored Aᵀ = S0ᵀ B₂ᵀ + (S0ᵀ Bᵀ) Bᵀ), row K the T = 0 part b.
 
     Needs ws.tangent and ws.x4 (:func:`shape_on_grid`); leaves Bᵀ, B₂ᵀ in ws.coupling
-    and the T = 0 force in ws.fields[0].
+    and the T = 0 force in ws.fields[0]; uses ws.fields[1:] as scratch.
     """
     m, k = ops.m, ops.S0.shape[1]
     tension_operator(ops, ws)
@@ -209,10 +211,10 @@ def length_rate_operator(g0, w, ops, ws):
     a_t = ws.length_rate[:k]
     np.dot(ops.S0T, b_t, ws.partial)  # (B S0)ᵀ
     np.dot(ops.S0T, b2_t, a_t)
-    extra = np.dot(ws.partial, b_t)
+    np.dot(ws.partial, b_t, ws.columns)
     for j in range(k):
         for i in range(m):
-            a_t[j, i] += extra[j, i]
+            a_t[j, i] += ws.columns[j, i]
     t, force, mobile = ws.tangent, ws.fields[0], ws.fields[1]
     for i in range(m):
         for c in range(3):
@@ -220,7 +222,8 @@ def length_rate_operator(g0, w, ops, ws):
         h = t[0, i] * force[0, i] + t[1, i] * force[1, i] + t[2, i] * force[2, i]
         for c in range(3):
             mobile[c, i] = force[c, i] + h * t[c, i]
-    dmobile = np.dot(mobile, ops.P1T)
+    dmobile = ws.fields[2]
+    np.dot(mobile, ops.P1T, dmobile)
     b = ws.length_rate[k]
     for i in range(m):
         stretch = t[0, i] ** 2 + t[1, i] ** 2 + t[2, i] ** 2
@@ -239,15 +242,18 @@ def loop_velocity(x, g0, w, ops, ws, u_out):
     m = ops.m
     shape_on_grid(x, ops, ws)
     length_rate_operator(g0, w, ops, ws)
-    if least_squares_normal(ws.length_rate, ops.column_scale, ws.tension, ws.gram) != 0:
+    if least_squares_normal(ws.length_rate, ops.column_scale, ws.tension, ws.gram,
+                            ws.residual, ws.correction) != 0:
         least_squares_affine(ws.length_rate, ws.tension, ws.tau)
     t = ws.tangent
-    tension = np.dot(ops.S0, ws.tension)
+    tension = ws.tension_grid
+    np.dot(ops.S0, ws.tension, tension)
     weighted = ws.fields[2]
     for c in range(3):
         for i in range(m):
             weighted[c, i] = t[c, i] * tension[i]
-    force = np.dot(weighted, ops.P1T)
+    force = ws.grid_force
+    np.dot(weighted, ops.P1T, force)
     for i in range(m):
         for c in range(3):
             force[c, i] += ws.fields[0, c, i]
