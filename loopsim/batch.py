@@ -74,7 +74,12 @@ def integrate_cases(method, constants, parameters, x0, t_end, options, cost=None
     order = np.arange(cases) if cost is None else np.argsort(-np.asarray(cost, float), kind="stable")
     lanes = numba.get_num_threads() if lanes is None else int(lanes)
     parameters = np.ascontiguousarray(np.asarray(parameters, dtype=float).reshape(cases, -1))
-    parallel_cases(method, constants, parameters, np.ascontiguousarray(x0), as_array(t0),
-                   as_array(t_end), options, order, lanes, y_final, t_final, status, counts,
-                   worst)
+    x0, t0, t_end = np.ascontiguousarray(x0), as_array(t0), as_array(t_end)
+    outputs = (y_final, t_final, status, counts, worst)
+    if lanes == 1:  # the serial kernel: Python threads may each run one (the sweep's work
+        # queue), while a parallel kernel is not to be launched from several threads at once
+        run_lane(0, 1, method, constants, parameters, x0, t0, t_end, options, order, *outputs)
+    else:
+        parallel_cases(method, constants, parameters, x0, t0, t_end, options, order, lanes,
+                       *outputs)
     return y_final, t_final, status, counts, worst

@@ -9,7 +9,7 @@ positions [k c, (k + 1) c) for chunk size c, and a file holds the positions
 [S, E) of a finished piece of a chunk, written under a temporary name and
 renamed into place.  A resume computes the positions no file holds, so a
 changed chunk size, a piece cut short by a signal and job-array shards all
-fit.  Pieces run on this machine's Numba threads or as Dask tasks.  No numerics
+fit.  Cases run on a work queue of this machine's threads or as Dask tasks.  No numerics
 here: integration is ``batch``, start shapes ``shapes``, summaries ``api``,
 tables ``io``.
 """
@@ -19,6 +19,7 @@ import itertools
 import json
 import math
 import os
+import queue
 import signal
 import sys
 import threading
@@ -31,6 +32,7 @@ import pyarrow as pa
 from . import (
     api, diagnostics, integrators, io, models, refinement, shapes, spectral, validation,
 )
+from ._blas import one_blas_thread
 from .config import (
     DEFAULT_ATOL, DEFAULT_LENGTH_TOL, DEFAULT_MAX_STEPS, DEFAULT_N_MAX, DEFAULT_PERTURBATION,
     DEFAULT_RTOL, DEFAULT_STEADY_INTERVAL, DEFAULT_STEADY_TOL, DEFAULT_T_END, DEFAULT_TAIL_TOL,
@@ -695,33 +697,82 @@ def _failures(table):
 
 
 # ---- running -------------------------------------------------------------------------------
-def _run_unit(config, part, threads):
+def _consecutive_runs(parts):
+    """Finished tasks {start: (positions, results, snapshots)} -> [(positions, results,
+    snapshots)], one per run of consecutive positions, tables concatenated in order."""
+    runs = []
+    for part, table, snapshots in (parts[k] for k in sorted(parts)):
+        if runs and runs[-1][0].stop == part.start:
+            previous = runs[-1]
+            runs[-1] = (range(previous[0].start, part.stop), previous[1] + [table],
+                        previous[2] + ([snapshots] if snapshots is not None else []))
+        else:
+            runs.append((part, [table], [snapshots] if snapshots is not None else []))
+    return [(positions, pa.concat_tables(tables), pa.concat_tables(snaps) if snaps else None)
+            for positions, tables, snaps in runs]
+
+
+def _queue_worker(config, tasks, results, halt):
+    """One worker thread of :func:`_run_local`: tasks (piece index, positions) from
+    ``tasks`` until it is empty or ``halt`` is set, each on one Numba thread (the kernels
+    release the GIL), their outputs or the first exception onto ``results``."""
     import numba
 
-    numba.set_num_threads(threads)  # per thread in Numba: set in the thread that runs
-    return run_chunk(config, part, threads)
+    numba.set_num_threads(1)  # per thread in Numba: set in the thread that runs
+    while not halt.is_set():
+        try:
+            index, part = tasks.get_nowait()
+        except queue.Empty:
+            return
+        try:
+            results.put((index, part, run_chunk(config, part, 1), None))
+        except BaseException as exc:  # noqa: BLE001 - handed to the sweep's thread
+            results.put((index, part, None, exc))
+            return
 
 
 def _run_local(config, out, fingerprint, pieces, threads, unit, progress, stop):
-    """The pieces on this machine's threads, each in units of ``unit`` positions; on a
-    stop request the finished units of the running piece are written as a shorter piece."""
-    for piece in pieces:
-        finished, tables, snapshots = piece.start, [], []
-        while finished < piece.stop:
-            part = range(finished, min(finished + unit, piece.stop))
-            result = _in_background(stop, _run_unit, config, part, threads)
-            if result is None:
-                break
-            tables.append(result[0])
-            if result[1] is not None:
-                snapshots.append(result[1])
-            finished = part.stop
-            progress.update(result[0].column("case_id").to_pylist(), _failures(result[0]))
-        if finished > piece.start:
-            write_piece(out, fingerprint, range(piece.start, finished), pa.concat_tables(tables),
-                        pa.concat_tables(snapshots) if snapshots else None)
-        if stop.is_set():
-            return
+    """The pieces' cases on a work queue served by ``threads`` worker threads, one Numba
+    thread each: tasks of ``unit`` consecutive positions go, in position order, to
+    whichever worker is free, so a costly case holds up one core, not the others.  A
+    piece is written as soon as all its tasks are done.  On a stop request (or an
+    error) no task starts any more; the finished tasks of unfinished pieces are written
+    as shorter pieces, one per run of consecutive positions, and the running ones are
+    lost."""
+    tasks, results, halt = queue.SimpleQueue(), queue.SimpleQueue(), threading.Event()
+    count = 0
+    for index, piece in enumerate(pieces):
+        for start in range(piece.start, piece.stop, unit):
+            tasks.put((index, range(start, min(start + unit, piece.stop))))
+            count += 1
+    finished = {}  # piece index -> {task start: (positions, results, snapshots)}
+    error = None
+    with one_blas_thread():  # BLAS's own threads would oversubscribe the cores
+        for k in range(min(threads, count)):
+            threading.Thread(target=_queue_worker, args=(config, tasks, results, halt),
+                             daemon=True, name=f"loopsim-sweep-{k}").start()
+        try:
+            while count and not stop.is_set():
+                try:
+                    index, part, output, error = results.get(timeout=0.1)
+                except queue.Empty:
+                    continue
+                count -= 1
+                if error is not None:
+                    break
+                table, snapshots = output
+                parts = finished.setdefault(index, {})
+                parts[part.start] = (part, table, snapshots)
+                progress.update(table.column("case_id").to_pylist(), _failures(table))
+                if sum(len(p[0]) for p in parts.values()) == len(pieces[index]):
+                    write_piece(out, fingerprint, *_consecutive_runs(finished.pop(index))[0])
+        finally:
+            halt.set()  # workers finish their running task and stop; its result is dropped
+            for parts in finished.values():
+                for run in _consecutive_runs(parts):
+                    write_piece(out, fingerprint, *run)
+    if error is not None:
+        raise error
 
 
 def _dask_client(scheduler, workers):
@@ -786,15 +837,15 @@ def run_sweep(config, out, threads=None, quiet=False, command_line=None, *, sche
               progress_interval=30.0, stream=None):
     """Run (or resume) a sweep into directory ``out``; returns the results DataFrame.
 
-    Backends: this machine's Numba threads (default; ``threads``, default all cores), a
+    Backends: this machine's cores (default; ``threads`` worker threads, default all
+    cores, serving a work queue of cases: :func:`_run_local`), a
     Dask cluster at ``scheduler`` or, with ``local_cluster``, a new Dask LocalCluster
     of ``workers`` processes (``threads`` Numba threads each, default 1).  ``shard``
     (i, n): only the chunks k with k % n == i (job arrays).  ``unit``: positions per
-    kernel call on the local backend (default: ``threads``, one case per lane, so a
-    signal loses at most the cases in flight; on a loaded 2-core machine 32 cases ran
-    in 36.5 s with units of 32, 36.9 s with 8 and 27.5 s with 2: no measurable cost).
+    task of the local work queue (default 1: a signal loses at most the cases in
+    flight).
     SIGINT/SIGTERM: finished cases are written, then :class:`SweepInterrupted` is
-    raised (the running kernel call's cases are lost).
+    raised (the running tasks' cases are lost).
     ``write`` (Dask): "client" (default: pieces come back and this process writes them;
     no shared filesystem needed) or "worker" (each worker writes its pieces into ``out``,
     which it must see at the same path); measured equal (README "Dask and job arrays").
@@ -830,7 +881,7 @@ def run_sweep(config, out, threads=None, quiet=False, command_line=None, *, sche
                     _close_cluster(cluster, grace)
         elif pieces:
             threads = threads or numba.config.NUMBA_NUM_THREADS
-            _run_local(config, out, fingerprint, pieces, threads, unit or threads, progress,
+            _run_local(config, out, fingerprint, pieces, threads, unit or 1, progress,
                        stop)
     progress.close()
     if stop.is_set():

@@ -6,6 +6,7 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 
 import pandas as pd
@@ -238,6 +239,62 @@ def test_resume_after_sigint_equals_uninterrupted_run(tmp_path):
     assert main(args + ["--quiet", "--out", str(out)]) == 0
     assert sorted(io.chunk_files(str(out))) == [piece, (piece[1], 9)]
     same_rows(loopsim.read_results(str(out)), loopsim.read_results(str(reference)))
+
+
+def _hold_position(monkeypatch, held):
+    """run_chunk, except that the task holding position ``held`` waits until every other
+    task has finished (or 60 s).  Returns (finish order of positions, release event)."""
+    real, finished, release = ensemble.run_chunk, [], threading.Event()
+
+    def run_chunk(config, chunk, threads):
+        if held in chunk:
+            release.wait(60)
+        output = real(config, chunk, threads)
+        finished.extend(chunk)
+        if len(finished) == len(config.cases) - 1 and held not in finished:
+            release.set()
+        return output
+
+    monkeypatch.setattr(ensemble, "run_chunk", run_chunk)
+    return finished, release
+
+
+def test_free_workers_go_past_a_slow_case(tmp_path, reference, monkeypatch):
+    """The local backend is a work queue: while one worker is held on position 0, the
+    other computes all five remaining positions (with units of --threads positions and a
+    barrier per unit, it would wait for position 0 first).  The table is unchanged."""
+    finished, release = _hold_position(monkeypatch, held=0)
+    start = time.monotonic()
+    frame = ensemble.run_sweep(config(snapshots_for=[4], snapshot_count=3), str(tmp_path / "q"),
+                               threads=2, quiet=True)
+    assert release.is_set() and time.monotonic() - start < 60
+    assert finished == [1, 2, 3, 4, 5, 0]
+    same_rows(frame, reference[1])
+
+
+def test_stop_writes_finished_cases_past_a_running_one(tmp_path, reference, monkeypatch):
+    """SIGINT while position 0 still runs and 1..5 are done: piece [0, 2) is written as
+    [1, 2), the others whole; the resume computes position 0 only, nothing twice."""
+    finished, release = _hold_position(monkeypatch, held=0)
+    real_set = release.set
+    release.set = lambda: os.kill(os.getpid(), signal.SIGINT)  # all but 0 done: interrupt
+    out = str(tmp_path / "q")
+    with pytest.raises(ensemble.SweepInterrupted):
+        ensemble.run_sweep(config(snapshots_for=[4], snapshot_count=3), out, threads=2,
+                           quiet=True)
+    real_set()  # the held worker goes on unseen, as a kernel would after a signal
+    assert sorted(io.chunk_files(out)) == [(1, 2), (2, 4), (4, 6)]
+    monkeypatch.undo()
+    computed = []
+    real = ensemble.run_chunk
+    monkeypatch.setattr(ensemble, "run_chunk",
+                        lambda c, chunk, t: computed.extend(chunk) or real(c, chunk, t))
+    frame = ensemble.run_sweep(config(snapshots_for=[4], snapshot_count=3), out, threads=2,
+                               quiet=True)
+    assert computed == [0]
+    assert sorted(io.chunk_files(out)) == [(0, 1), (1, 2), (2, 4), (4, 6)]
+    same_rows(frame, reference[1])
+    assert len(loopsim.read_snapshots(out)) == 3
 
 
 @pytest.mark.parametrize("argv, word", [
