@@ -146,8 +146,11 @@ def test_progress_goes_to_a_log_file_with_a_cost_weighted_eta(monkeypatch):
     assert len(lines) == 2 and "\r" not in stream.getvalue()
     assert lines[0].startswith("cases 2/3") and "failures 1" in lines[0]
     assert "elapsed 0h00m20s ETA 0h01m20s" in lines[0], lines[0]
-    assert ensemble.case_weight(dict(g0=150.0, theta0_deg=60.0, n=4)) == 3 * ensemble.case_weight(
-        dict(g0=10.0, theta0_deg=30.0, n=4))
+    stable, loop_3d = dict(g0=10.0, theta0_deg=30.0, n=4), dict(g0=150.0, theta0_deg=60.0, n=4)
+    assert ensemble.case_weight(loop_3d) == 3 * ensemble.case_weight(stable)
+    q0 = 150.0 * 3**0.5 / 2 / 3  # --n auto: (q0 / 11)^4 times a stable case
+    assert ensemble.case_weight(loop_3d, n_auto=True) == pytest.approx(
+        (q0 / 11.0) ** 4 * ensemble.case_weight(stable, n_auto=True), rel=1e-12)
     quiet = stdio.StringIO()
     progress = ensemble.Progress(weights, [], quiet=True, stream=quiet, interval=0.0)
     progress.update([0], 0)
