@@ -710,14 +710,16 @@ def _failures(table):
 def _consecutive_runs(parts):
     """Finished tasks {start: (positions, results, snapshots)} -> [(positions, results,
     snapshots)], one per run of consecutive positions, tables concatenated in order."""
-    runs = []
-    for part, table, snapshots in (parts[k] for k in sorted(parts)):
-        if runs and runs[-1][0].stop == part.start:
-            previous = runs[-1]
-            runs[-1] = (range(previous[0].start, part.stop), previous[1] + [table],
-                        previous[2] + ([snapshots] if snapshots is not None else []))
-        else:
-            runs.append((part, [table], [snapshots] if snapshots is not None else []))
+    runs = []  # [positions, result tables, snapshot tables]
+    for start in sorted(parts):
+        part, table, snapshots = parts[start]
+        if not runs or runs[-1][0].stop != part.start:
+            runs.append([part, [], []])
+        run = runs[-1]
+        run[0] = range(run[0].start, part.stop)
+        run[1].append(table)
+        if snapshots is not None:
+            run[2].append(snapshots)
     return [(positions, pa.concat_tables(tables), pa.concat_tables(snaps) if snaps else None)
             for positions, tables, snaps in runs]
 
@@ -756,6 +758,7 @@ def _run_local(config, out, fingerprint, pieces, threads, unit, progress, stop):
             tasks.put((index, range(start, min(start + unit, piece.stop))))
             count += 1
     finished = {}  # piece index -> {task start: (positions, results, snapshots)}
+    left = [len(piece) for piece in pieces]  # positions still to finish, per piece
     error = None
     with one_blas_thread():  # BLAS's own threads would oversubscribe the cores
         for k in range(min(threads, count)):
@@ -774,7 +777,8 @@ def _run_local(config, out, fingerprint, pieces, threads, unit, progress, stop):
                 parts = finished.setdefault(index, {})
                 parts[part.start] = (part, table, snapshots)
                 progress.update(table.column("case_id").to_pylist(), _failures(table))
-                if sum(len(p[0]) for p in parts.values()) == len(pieces[index]):
+                left[index] -= len(part)
+                if not left[index]:
                     write_piece(out, fingerprint, *_consecutive_runs(finished.pop(index))[0])
         finally:
             halt.set()  # workers finish their running task and stop; its result is dropped
