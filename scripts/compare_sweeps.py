@@ -1,10 +1,12 @@
 """Compare two sweeps of the same cases: regimes, terminal tilt and shape, cost.
 
-Usage: python scripts/compare_sweeps.py REFERENCE OTHER [--tilt-tol 1] [--json FILE]
+Usage: python scripts/compare_sweeps.py REFERENCE OTHER [--tilt-tol 1] [--common] [--json FILE]
 
 REFERENCE and OTHER are sweep directories (``loopsim sweep --out``) over the same
 (g0, θ0, seed) cases, for example the resolved grid (``--n auto``) and the paper's
-n = 6 main job.  Rows are matched on (g0, theta0_deg, seed).  Prints, as Markdown:
+n = 6 main job.  Rows are matched on (g0, theta0_deg, seed); with ``--common`` only the
+cases both hold are compared (a sweep still running: its finished cases are a sample
+spread over the grid, see ``io.case_order``).  Prints, as Markdown:
 
 * each sweep's regime counts, resolved rows and the distribution of ``n_used``;
 * the regime cross-table (rows: REFERENCE, columns: OTHER) and how many cases change
@@ -36,9 +38,9 @@ def summary(name, frame):
                 nfev=int(frame["nfev"].sum()))
 
 
-def compare(reference, other, tilt_tol):
+def compare(reference, other, tilt_tol, common=False):
     both = reference.merge(other, on=KEY, suffixes=("_ref", "_other"), validate="one_to_one")
-    if len(both) != len(reference) or len(both) != len(other):
+    if not common and (len(both) != len(reference) or len(both) != len(other)):
         raise SystemExit(f"the sweeps hold different cases ({len(reference)} and {len(other)} "
                          f"rows, {len(both)} in common)")
     tilt = (both["theta_final_deg_other"] - both["theta_final_deg_ref"]).abs()
@@ -48,7 +50,7 @@ def compare(reference, other, tilt_tol):
     by_regime = {r: dict(cases=int((both["regime_ref"] == r).sum()),
                          moved=int(((both["regime_ref"] == r) & (tilt > tilt_tol)).sum()))
                  for r in sorted(both["regime_ref"].unique())}
-    return dict(cross=cross, changed=int(changed.sum()), moved=int((tilt > tilt_tol).sum()),
+    return dict(cases=len(both), cross=cross, changed=int(changed.sum()), moved=int((tilt > tilt_tol).sum()),
                 moved_by_regime=by_regime, tilt_max=float(tilt.max()),
                 aspect_max=float(aspect.max()),
                 changed_cases=both.loc[changed, KEY + ["regime_ref", "regime_other"]])
@@ -77,6 +79,8 @@ def main():
     parser.add_argument("other")
     parser.add_argument("--tilt-tol", type=float, default=1.0,
                         help="a case 'moves' when its terminal tilts differ by more (degrees)")
+    parser.add_argument("--common", action="store_true",
+                        help="compare only the cases both sweeps hold")
     parser.add_argument("--json", help="also write the numbers to this JSON file")
     args = parser.parse_args()
     reference, other = loopsim.read_results(args.reference), loopsim.read_results(args.other)
@@ -85,8 +89,9 @@ def main():
         print(f"## {s['name']}: {s['cases']} cases; regimes {s['regimes']}; resolved "
               f"{s['resolved']}; n_used {s['n_used']}; methods {s['methods']}; "
               f"sum of wall_s {s['wall_core_s']:.0f} core-s; RHS evaluations {s['nfev']}")
-    result = compare(reference, other, args.tilt_tol)
-    print(f"\nRegimes (rows: {args.reference}, columns: {args.other}):\n")
+    result = compare(reference, other, args.tilt_tol, args.common)
+    print(f"\nRegimes of the {result['cases']} cases both hold (rows: {args.reference}, "
+          f"columns: {args.other}):\n")
     print(markdown(result["cross"]))
     print(f"\n{result['changed']} cases change regime; {result['moved']} move by more than "
           f"{args.tilt_tol}° in terminal tilt (by regime of the reference: "
@@ -101,7 +106,7 @@ def main():
             print(f"| {n} | {k} | {median:.3g} | {p90:.3g} | {top:.3g} | {total:.0f} |")
     if args.json:
         with open(args.json, "w") as handle:
-            json.dump(dict(sweeps=sums, changed=result["changed"], moved=result["moved"],
+            json.dump(dict(sweeps=sums, cases=result["cases"], changed=result["changed"], moved=result["moved"],
                            moved_by_regime=result["moved_by_regime"],
                            tilt_max=result["tilt_max"], aspect_max=result["aspect_max"],
                            cross=result["cross"].to_dict()), handle, indent=1)
