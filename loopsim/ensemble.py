@@ -78,7 +78,9 @@ def classify(theta0_deg, theta_final_deg, aspect_initial, aspect_final, ok, thre
 
 # ---- the table (schema: io.RESULT_SCHEMA) ----------------------------------
 FIELD_NOTES = {
-    "wall_s": "share of the chunk's wall time x threads, in proportion to nfev",
+    "wall_s": "wall time of the case's task (a task of several cases, or a batch kernel "
+              "call on several threads: its wall time x threads, shared in proportion to "
+              "nfev)",
     "x_final": "terminal shape coefficients, row-major (3, 2n+1): " + io.COEFFICIENT_LAYOUT,
     "regime": "stable | in-plane | 3d | failed (see thresholds)",
     "stop_reason": "t_end | steady (terminal state reached early) | the failure",
@@ -374,10 +376,10 @@ def run_chunk(config, chunk, threads):
     """Integrate one chunk's cases.
 
     Returns (results Table in RESULT_SCHEMA, snapshots Table or None).  Cases
-    without snapshots run in the parallel batch kernel (``refinement.integrate_cases``:
-    a fixed n is a ladder of one order), grouped by starting n, method and rtol; their
-    ``wall_s`` is the batch's wall time x threads shared in proportion to RHS
-    evaluations.
+    without snapshots run in the batch kernel (``refinement.integrate_cases``: a fixed
+    n is a ladder of one order; parallel over ``threads`` lanes, serial on one), grouped
+    by starting n, method and rtol; their ``wall_s`` is the batch's wall time x threads
+    shared in proportion to RHS evaluations (a single case: its own wall time).
     """
     ids = chunk_case_ids(config, chunk)
     traced = sorted(set(ids) & set(config.snapshots_for))
@@ -707,21 +709,12 @@ def _failures(table):
 
 
 # ---- running -------------------------------------------------------------------------------
-def _consecutive_runs(parts):
-    """Finished tasks {start: (positions, results, snapshots)} -> [(positions, results,
-    snapshots)], one per run of consecutive positions, tables concatenated in order."""
-    runs = []  # [positions, result tables, snapshot tables]
-    for start in sorted(parts):
-        part, table, snapshots = parts[start]
-        if not runs or runs[-1][0].stop != part.start:
-            runs.append([part, [], []])
-        run = runs[-1]
-        run[0] = range(run[0].start, part.stop)
-        run[1].append(table)
-        if snapshots is not None:
-            run[2].append(snapshots)
-    return [(positions, pa.concat_tables(tables), pa.concat_tables(snaps) if snaps else None)
-            for positions, tables, snaps in runs]
+def _joined(parts):
+    """Finished tasks [(positions, results, snapshots)] of consecutive positions, in
+    order -> one (positions, results, snapshots)."""
+    snapshots = [p[2] for p in parts if p[2] is not None]
+    return (range(parts[0][0].start, parts[-1][0].stop), pa.concat_tables([p[1] for p in parts]),
+            pa.concat_tables(snapshots) if snapshots else None)
 
 
 def _queue_worker(config, tasks, results, halt):
@@ -748,9 +741,10 @@ def _run_local(config, out, fingerprint, pieces, threads, unit, progress, stop):
     thread each: tasks of ``unit`` consecutive positions go, in position order, to
     whichever worker is free, so a costly case holds up one core, not the others.  A
     piece is written as soon as all its tasks are done.  On a stop request (or an
-    error) no task starts any more; the finished tasks of unfinished pieces are written
-    as shorter pieces, one per run of consecutive positions, and the running ones are
-    lost."""
+    error) no task starts any more, and every finished task of an unfinished piece is
+    written as a piece of its own (so identical sweeps stopped side by side write
+    identical, disjoint or nested files, never overlapping ones); the running tasks are
+    lost (their threads run on, unseen, until the kernel returns)."""
     tasks, results, halt = queue.SimpleQueue(), queue.SimpleQueue(), threading.Event()
     count = 0
     for index, piece in enumerate(pieces):
@@ -760,31 +754,40 @@ def _run_local(config, out, fingerprint, pieces, threads, unit, progress, stop):
     finished = {}  # piece index -> {task start: (positions, results, snapshots)}
     left = [len(piece) for piece in pieces]  # positions still to finish, per piece
     error = None
+
+    def collect(index, part, output):
+        finished.setdefault(index, {})[part.start] = (part,) + tuple(output)
+        progress.update(output[0].column("case_id").to_pylist(), _failures(output[0]))
+        left[index] -= len(part)
+        if not left[index]:
+            parts = finished.pop(index)
+            write_piece(out, fingerprint, *_joined([parts[k] for k in sorted(parts)]))
+
     with one_blas_thread():  # BLAS's own threads would oversubscribe the cores
         for k in range(min(threads, count)):
             threading.Thread(target=_queue_worker, args=(config, tasks, results, halt),
                              daemon=True, name=f"loopsim-sweep-{k}").start()
         try:
-            while count and not stop.is_set():
+            while count and error is None and not stop.is_set():
                 try:
                     index, part, output, error = results.get(timeout=0.1)
                 except queue.Empty:
                     continue
                 count -= 1
-                if error is not None:
-                    break
-                table, snapshots = output
-                parts = finished.setdefault(index, {})
-                parts[part.start] = (part, table, snapshots)
-                progress.update(table.column("case_id").to_pylist(), _failures(table))
-                left[index] -= len(part)
-                if not left[index]:
-                    write_piece(out, fingerprint, *_consecutive_runs(finished.pop(index))[0])
+                if error is None:
+                    collect(index, part, output)
         finally:
-            halt.set()  # workers finish their running task and stop; its result is dropped
+            halt.set()  # workers finish their running task and stop
+            while True:  # results already handed over are kept
+                try:
+                    index, part, output, late_error = results.get_nowait()
+                except queue.Empty:
+                    break
+                if late_error is None:
+                    collect(index, part, output)
             for parts in finished.values():
-                for run in _consecutive_runs(parts):
-                    write_piece(out, fingerprint, *run)
+                for key in sorted(parts):
+                    write_piece(out, fingerprint, *parts[key])
     if error is not None:
         raise error
 
@@ -859,7 +862,8 @@ def run_sweep(config, out, threads=None, quiet=False, command_line=None, *, sche
     task of the local work queue (default 1: a signal loses at most the cases in
     flight).
     SIGINT/SIGTERM: finished cases are written, then :class:`SweepInterrupted` is
-    raised (the running tasks' cases are lost).
+    raised (the running tasks' cases are lost; called from Python, their worker threads
+    run on until their kernel returns, then stop).
     ``write`` (Dask): "client" (default: pieces come back and this process writes them;
     no shared filesystem needed) or "worker" (each worker writes its pieces into ``out``,
     which it must see at the same path); measured equal (README "Dask and job arrays").
@@ -872,6 +876,9 @@ def run_sweep(config, out, threads=None, quiet=False, command_line=None, *, sche
     distributed = scheduler is not None or local_cluster
     if write not in ("worker", "client"):
         raise ValueError(f"write must be 'worker' or 'client', got {write!r}")
+    for name, value in (("threads", threads), ("unit", unit)):
+        if value is not None:
+            validation.check_integer(name, value, 1)
     fingerprint = _prepare_directory(out, config, command_line or [])
     covered = io.chunk_files(out)
     pieces = pending_pieces(config, covered, shard)

@@ -1,12 +1,13 @@
-"""Dask against prange: the same sweep on this machine's threads and on a LocalCluster.
+"""Dask against the local backend: the same sweep on this machine's threads and on a LocalCluster.
 
 Usage: python scripts/bench_dask.py [--t-end 3] [--chunk-size 8] [--workers 2]
 
 1. The 64-case grid of scripts/bench_ensemble.py (g0 = 10..350 x theta0 = 6..90 deg,
-   n = 6), once with prange on 2 threads, once on a LocalCluster of 2 worker processes x
-   1 Numba thread, with each worker writing its chunks (write="worker") and with the
-   chunks sent back to this process, which writes them (write="client").  Every run is
-   checked to give the same rows as the prange run.
+   n = 6), once on the local backend (2 threads: a prange kernel when the README's
+   table was measured, a work queue since), once on a LocalCluster of 2 worker
+   processes x 1 Numba thread, with each worker writing its chunks (write="worker") and
+   with the chunks sent back to this process, which writes them (write="client").
+   Every run is checked to give the same rows as the local run.
 2. Per-task overhead: 64 tiny cases (t_end = 1e-6, one case per chunk = one task each)
    on the cluster, against the same 64 pieces run one by one here.
 Cluster start-up and the workers' first kernel load (from the on-disk cache) are timed
@@ -47,7 +48,7 @@ def main():
     local, reference = timed(config, threads=2)
     print(f"# {len(cases)} cases, n = 6, t_end = {args.t_end}, chunk size {args.chunk_size} "
           f"({config.n_chunks} tasks)")
-    print(f"prange, 2 threads:                       {local:7.2f} s")
+    print(f"local backend, 2 threads:                {local:7.2f} s")
 
     start = time.perf_counter()
     cluster = LocalCluster(n_workers=args.workers, threads_per_worker=1, processes=True,
@@ -64,7 +65,7 @@ def main():
         pd.testing.assert_frame_equal(frame[DETERMINISTIC], reference[DETERMINISTIC],
                                       check_exact=True)
         print(f"dask {args.workers} x 1 thread, {write} writes:      {wall:7.2f} s  "
-              f"(overhead {100 * (wall / local - 1):+.0f}% against prange; rows identical)")
+              f"(overhead {100 * (wall / local - 1):+.0f}% against the local backend; rows identical)")
 
     dask_tiny, _ = timed(tiny, scheduler=address, threads=1)
     here_tiny, _ = timed(tiny, threads=1)

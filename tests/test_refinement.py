@@ -161,14 +161,46 @@ def test_auto_method_by_expected_regime():
     assert refinement.auto_method(20.0, 6, True) == "radau5"  # climbs
 
 
+def blas_threads():
+    from threadpoolctl import threadpool_info
+
+    return {i["filepath"]: i["num_threads"] for i in threadpool_info() if i["user_api"] == "blas"}
+
+
+def test_blas_limit_belongs_to_its_first_holder():
+    """The limit is process-wide: a sweep's worker thread entering it while the sweep
+    holds it changes nothing, and the sweep's exit restores the caller's setting even
+    while a worker abandoned after an interrupt is still inside."""
+    import threading
+
+    from threadpoolctl import threadpool_limits
+
+    entered, leave = threading.Event(), threading.Event()
+
+    def worker():
+        with refinement.one_blas_thread():
+            entered.set()
+            leave.wait(10)
+
+    with threadpool_limits(limits=2, user_api="blas"):
+        with refinement.one_blas_thread():
+            thread = threading.Thread(target=worker)
+            thread.start()
+            assert entered.wait(10)
+            assert set(blas_threads().values()) == {1}
+        assert set(blas_threads().values()) == {2}  # restored; the worker is still inside
+        leave.set()
+        thread.join()
+        assert set(blas_threads().values()) == {2}
+        with refinement.one_blas_thread():  # free again for the next holder
+            assert set(blas_threads().values()) == {1}
+        assert set(blas_threads().values()) == {2}
+
+
 def test_integrations_run_with_one_blas_thread(monkeypatch):
     """Both entry points hold BLAS to one thread while the kernels run (the cases are
     parallel already; loopsim._blas), and restore the user's setting afterwards."""
-    from threadpoolctl import threadpool_info, threadpool_limits
-
-    def blas_threads():
-        return {i["filepath"]: i["num_threads"] for i in threadpool_info()
-                if i["user_api"] == "blas"}
+    from threadpoolctl import threadpool_limits
 
     seen = []
 

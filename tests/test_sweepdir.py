@@ -244,9 +244,10 @@ def test_resume_after_sigint_equals_uninterrupted_run(tmp_path):
     same_rows(loopsim.read_results(str(out)), loopsim.read_results(str(reference)))
 
 
-def _hold_position(monkeypatch, held):
+def _hold_position(monkeypatch, held, auto_release=True):
     """run_chunk, except that the task holding position ``held`` waits until every other
-    task has finished (or 60 s).  Returns (finish order of positions, release event)."""
+    task has finished (or 60 s; without ``auto_release``, until the caller sets the
+    event).  Returns (finish order of positions, release event)."""
     real, finished, release = ensemble.run_chunk, [], threading.Event()
 
     def run_chunk(config, chunk, threads):
@@ -254,7 +255,7 @@ def _hold_position(monkeypatch, held):
             release.wait(60)
         output = real(config, chunk, threads)
         finished.extend(chunk)
-        if len(finished) == len(config.cases) - 1 and held not in finished:
+        if auto_release and len(finished) == len(config.cases) - 1 and held not in finished:
             release.set()
         return output
 
@@ -265,7 +266,12 @@ def _hold_position(monkeypatch, held):
 def test_free_workers_go_past_a_slow_case(tmp_path, reference, monkeypatch):
     """The local backend is a work queue: while one worker is held on position 0, the
     other computes all five remaining positions (with units of --threads positions and a
-    barrier per unit, it would wait for position 0 first).  The table is unchanged."""
+    barrier per unit, it would wait for position 0 first).  The table is unchanged.  The
+    held worker waits in Python; the kernels let two workers compute at once because
+    they release the GIL (nogil), checked on the kernel the workers call."""
+    from loopsim import batch
+
+    assert batch.run_lane.targetoptions.get("nogil") is True
     finished, release = _hold_position(monkeypatch, held=0)
     start = time.monotonic()
     frame = ensemble.run_sweep(config(snapshots_for=[4], snapshot_count=3), str(tmp_path / "q"),
@@ -275,29 +281,69 @@ def test_free_workers_go_past_a_slow_case(tmp_path, reference, monkeypatch):
     same_rows(frame, reference[1])
 
 
-def test_stop_writes_finished_cases_past_a_running_one(tmp_path, reference, monkeypatch):
-    """SIGINT while position 0 still runs and 1..5 are done: piece [0, 2) is written as
-    [1, 2), the others whole; the resume computes position 0 only, nothing twice."""
-    finished, release = _hold_position(monkeypatch, held=0)
-    real_set = release.set
-    release.set = lambda: os.kill(os.getpid(), signal.SIGINT)  # all but 0 done: interrupt
-    out = str(tmp_path / "q")
-    with pytest.raises(ensemble.SweepInterrupted):
-        ensemble.run_sweep(config(snapshots_for=[4], snapshot_count=3), out, threads=2,
-                           quiet=True)
-    real_set()  # the held worker goes on unseen, as a kernel would after a signal
-    assert sorted(io.chunk_files(out)) == [(1, 2), (2, 4), (4, 6)]
+def _interrupt_after(monkeypatch, cases):
+    """SIGINT to this process, from the sweep's own thread, once ``cases`` cases are done."""
+    real = ensemble.Progress.update
+
+    def update(self, case_ids, failures):
+        real(self, case_ids, failures)
+        if self.done == cases:
+            os.kill(os.getpid(), signal.SIGINT)
+
+    monkeypatch.setattr(ensemble.Progress, "update", update)
+
+
+def _resume_computes(monkeypatch, out, expected):
+    """Resume the sweep in ``out`` and check that it computes exactly ``expected``
+    positions; returns the table."""
     monkeypatch.undo()
-    computed = []
-    real = ensemble.run_chunk
+    computed, real = [], ensemble.run_chunk
     monkeypatch.setattr(ensemble, "run_chunk",
                         lambda c, chunk, t: computed.extend(chunk) or real(c, chunk, t))
     frame = ensemble.run_sweep(config(snapshots_for=[4], snapshot_count=3), out, threads=2,
                                quiet=True)
-    assert computed == [0]
+    assert sorted(computed) == sorted(expected)
+    return frame
+
+
+def test_stop_writes_finished_cases_past_a_running_one(tmp_path, reference, monkeypatch):
+    """SIGINT once positions 1..5 are done while position 0 still runs: piece [0, 2) is
+    written as [1, 2), the others whole; the resume computes position 0 only."""
+    _, release = _hold_position(monkeypatch, held=0, auto_release=False)
+    _interrupt_after(monkeypatch, 5)
+    out = str(tmp_path / "q")
+    with pytest.raises(ensemble.SweepInterrupted):
+        ensemble.run_sweep(config(snapshots_for=[4], snapshot_count=3), out, threads=2,
+                           quiet=True)
+    release.set()  # the held worker goes on unseen, as a kernel would after a signal
+    assert sorted(io.chunk_files(out)) == [(1, 2), (2, 4), (4, 6)]
+    frame = _resume_computes(monkeypatch, out, [0])
     assert sorted(io.chunk_files(out)) == [(0, 1), (1, 2), (2, 4), (4, 6)]
     same_rows(frame, reference[1])
     assert len(loopsim.read_snapshots(out)) == 3
+
+
+def test_worker_error_is_raised_after_finished_cases_are_written(tmp_path, reference,
+                                                                monkeypatch):
+    """An exception in a worker (not a failed case: those are rows) stops the sweep and
+    is raised; the cases finished by then are written and the resume computes the rest,
+    each once."""
+    real = ensemble.run_chunk
+
+    def run_chunk(config, chunk, threads):
+        if 3 in chunk:
+            raise RuntimeError("worker broke at position 3")
+        return real(config, chunk, threads)
+
+    monkeypatch.setattr(ensemble, "run_chunk", run_chunk)
+    out = str(tmp_path / "e")
+    with pytest.raises(RuntimeError, match="position 3"):
+        ensemble.run_sweep(config(snapshots_for=[4], snapshot_count=3), out, threads=2,
+                           quiet=True)
+    written = [p for low, high in io.chunk_files(out) for p in range(low, high)]
+    assert 3 not in written and len(set(written)) == len(written)
+    frame = _resume_computes(monkeypatch, out, sorted(set(range(6)) - set(written)))
+    same_rows(frame, reference[1])
 
 
 @pytest.mark.parametrize("argv, word", [
