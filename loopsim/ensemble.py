@@ -741,10 +741,11 @@ def _run_local(config, out, fingerprint, pieces, threads, unit, progress, stop):
     thread each: tasks of ``unit`` consecutive positions go, in position order, to
     whichever worker is free, so a costly case holds up one core, not the others.  A
     piece is written as soon as all its tasks are done.  On a stop request (or an
-    error) no task starts any more, and every finished task of an unfinished piece is
-    written as a piece of its own (so identical sweeps stopped side by side write
-    identical, disjoint or nested files, never overlapping ones); the running tasks are
-    lost (their threads run on, unseen, until the kernel returns)."""
+    error) no task starts any more; of each unfinished piece, the finished tasks from
+    its start are written as one shorter piece and every later finished task as a piece
+    of its own (so identical sweeps stopped side by side write identical, disjoint or
+    nested files, never overlapping ones); the running tasks are lost (their threads
+    run on, unseen, until the kernel returns)."""
     tasks, results, halt = queue.SimpleQueue(), queue.SimpleQueue(), threading.Event()
     count = 0
     for index, piece in enumerate(pieces):
@@ -785,9 +786,16 @@ def _run_local(config, out, fingerprint, pieces, threads, unit, progress, stop):
                     break
                 if late_error is None:
                     collect(index, part, output)
-            for parts in finished.values():
-                for key in sorted(parts):
-                    write_piece(out, fingerprint, *parts[key])
+            for index, parts in finished.items():
+                done = [parts[k] for k in sorted(parts)]
+                prefix, reached = 0, pieces[index].start  # tasks from the piece's start
+                while prefix < len(done) and done[prefix][0].start == reached:
+                    reached = done[prefix][0].stop
+                    prefix += 1
+                if prefix:
+                    write_piece(out, fingerprint, *_joined(done[:prefix]))
+                for task in done[prefix:]:
+                    write_piece(out, fingerprint, *task)
     if error is not None:
         raise error
 
