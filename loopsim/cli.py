@@ -500,8 +500,10 @@ def _cmd_sweep(args):
         print(f"{len(unresolved)} of {len(frame)} cases NOT resolved at their n (transient length "
               f"error > {config.thresholds.resolved_length_error:g} or spectral tail along the "
               f"run > {config.thresholds.resolved_tail:g}; column 'resolved'): their "
-              f"terminal tilt and shape are not converged; rerun them with a larger --n or "
-              f"--n auto (regimes among them: " + ", ".join(
+              f"terminal tilt and shape are not converged; rerun them with "
+              + (f"a larger --n-max than {config.n_max} (a cases file of their g0, theta0_deg "
+                 f"and seed)" if config.n_auto else "a larger --n or --n auto")
+              + " (regimes among them: " + ", ".join(
                   f"{k} {v}" for k, v in sorted(unresolved["regime"].value_counts().items())) + ")")
     if args.figure:
         _use_agg()

@@ -69,6 +69,19 @@ def test_sweep_marks_under_resolved_cases(tmp_path, capsys):
     stdout = capsys.readouterr().out
     unresolved = int((~frame["resolved"]).sum())
     assert f"{unresolved} of 4 cases NOT resolved" in stdout
+    assert "rerun them with a larger --n or --n auto" in stdout
+
+
+def test_auto_sweep_names_n_max_for_unresolved_cases(tmp_path, capsys):
+    """--n auto: a case still unresolved at --n-max (g0 = 150, θ0 = 60° at n = 8) is
+    counted, and the hint names --n-max, not --n."""
+    out = tmp_path / "auto"
+    assert main(["sweep", "--g0", "150", "--theta0", "60", "--n", "auto", "--n-max", "8",
+                 "--method", "radau5", "--t-end", "1", "--quiet", "--out", str(out)]) == 0
+    (row,) = loopsim.read_results(str(out)).itertuples()
+    assert row.n_used == 8 and not row.resolved
+    assert "1 of 1 cases NOT resolved" in (stdout := capsys.readouterr().out)
+    assert "a larger --n-max than 8" in stdout
 
 
 def test_parse_values():
