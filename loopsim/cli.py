@@ -15,8 +15,9 @@ import warnings
 
 from ._version import __version__
 from .config import (
-    DEFAULT_ATOL, DEFAULT_N, DEFAULT_N_MAX, DEFAULT_PERTURBATION, DEFAULT_RTOL, DEFAULT_SEED,
-    DEFAULT_T_END, DEFAULT_TAIL_TOL, DEFAULT_W, RESOLVED_LENGTH_ERROR, RESOLVED_TAIL,
+    DEFAULT_ATOL, DEFAULT_AUTO_CHUNK_SIZE, DEFAULT_CHUNK_SIZE, DEFAULT_N, DEFAULT_N_MAX,
+    DEFAULT_PERTURBATION, DEFAULT_RTOL, DEFAULT_SEED, DEFAULT_T_END, DEFAULT_TAIL_TOL, DEFAULT_W,
+    RESOLVED_LENGTH_ERROR, RESOLVED_TAIL,
 )
 
 from .integrators import METHODS  # noqa: E402 - the names only; no kernel is compiled here
@@ -164,8 +165,11 @@ def _build_parser():
     sweep.add_argument("--snapshots", type=int, default=101, metavar="K",
                        help="snapshots per selected trajectory")
     sweep.add_argument("--threads", type=int, default=None, help="threads (default: all cores)")
-    sweep.add_argument("--chunk-size", type=int, default=32,
-                       help="cases per chunk file (and per Dask task); may change on resume")
+    sweep.add_argument("--chunk-size", type=int, default=None,
+                       help="cases per chunk file (and per Dask task; default "
+                       f"{DEFAULT_CHUNK_SIZE}, or {DEFAULT_AUTO_CHUNK_SIZE} with --n auto, "
+                       "whose cases take minutes: a SIGKILL loses the unwritten chunks); may "
+                       "change on resume")
     sweep.add_argument("--out", metavar="DIR", help="sweep directory (required)")
     sweep.add_argument("--figure", metavar="PNG", help="also draw the phase diagram")
     sweep.add_argument("--quiet", action="store_true", help="no progress line, only a summary")
@@ -421,7 +425,10 @@ def _sweep_config(args, ensemble):
                              f"more than a sweep's {validation.MAX_CASES}: split it")
         cases = ensemble.grid_cases(*axes, args.seeds, args.perturbation)
     return ensemble.SweepConfig(cases=cases, t_end=args.t_end, rtol=args.rtol, atol=args.atol,
-                                w=args.w, method=args.method, chunk_size=args.chunk_size,
+                                w=args.w, method=args.method,
+                                chunk_size=(args.chunk_size if args.chunk_size is not None
+                                            else DEFAULT_AUTO_CHUNK_SIZE if args.n == "auto"
+                                            else DEFAULT_CHUNK_SIZE),
                                 early_stop=not args.no_early_stop,
                                 snapshots_for=ensemble.parse_values(
                                     args.snapshots_for, "--snapshots-for", integer=True)

@@ -28,6 +28,10 @@ DEFAULT_ATOL = 1e-9
 DEFAULT_PERTURBATION = 1e-3
 DEFAULT_SEED = 0
 DEFAULT_MAX_STEPS = 2_000_000
+#: Cases per chunk file of a sweep by default, and with ``n="auto"``, whose 3D cases take
+#: minutes: a SIGKILL loses the chunks not yet written (up to threads + 1 of them).
+DEFAULT_CHUNK_SIZE = 32
+DEFAULT_AUTO_CHUNK_SIZE = 4
 #: Relative length error beyond which a run stops with status LENGTH_ERROR.
 DEFAULT_LENGTH_TOL = 0.25
 #: Early stop at the terminal state: every DEFAULT_STEADY_INTERVAL time units the

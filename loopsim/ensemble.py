@@ -34,9 +34,9 @@ from . import (
 )
 from ._blas import one_blas_thread
 from .config import (
-    DEFAULT_ATOL, DEFAULT_LENGTH_TOL, DEFAULT_MAX_STEPS, DEFAULT_N_MAX, DEFAULT_PERTURBATION,
-    DEFAULT_RTOL, DEFAULT_STEADY_INTERVAL, DEFAULT_STEADY_TOL, DEFAULT_T_END, DEFAULT_TAIL_TOL,
-    DEFAULT_W, RESOLVED_LENGTH_ERROR, RESOLVED_TAIL,
+    DEFAULT_ATOL, DEFAULT_CHUNK_SIZE, DEFAULT_LENGTH_TOL, DEFAULT_MAX_STEPS, DEFAULT_N_MAX,
+    DEFAULT_PERTURBATION, DEFAULT_RTOL, DEFAULT_STEADY_INTERVAL, DEFAULT_STEADY_TOL,
+    DEFAULT_T_END, DEFAULT_TAIL_TOL, DEFAULT_W, RESOLVED_LENGTH_ERROR, RESOLVED_TAIL,
 )
 
 REGIMES = ("stable", "in-plane", "3d", "failed")
@@ -137,7 +137,7 @@ class SweepConfig:
     method: str = "rkf45"
     max_steps: int = DEFAULT_MAX_STEPS
     length_tol: float = DEFAULT_LENGTH_TOL
-    chunk_size: int = 32
+    chunk_size: int = DEFAULT_CHUNK_SIZE
     early_stop: bool = True
     snapshots_for: list = dataclasses.field(default_factory=list)  # case ids
     snapshot_count: int = 101

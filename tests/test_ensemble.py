@@ -15,6 +15,7 @@ import pytest
 import loopsim
 from loopsim import ensemble, io
 from loopsim.cli import main
+from loopsim.config import DEFAULT_AUTO_CHUNK_SIZE
 
 DETERMINISTIC = [c for c in io.RESULT_SCHEMA.names if c != "wall_s"]
 
@@ -80,6 +81,8 @@ def test_auto_sweep_names_n_max_for_unresolved_cases(tmp_path, capsys):
                  "--method", "radau5", "--t-end", "1", "--quiet", "--out", str(out)]) == 0
     (row,) = loopsim.read_results(str(out)).itertuples()
     assert row.n_used == 8 and not row.resolved
+    chunk_size = loopsim.read_results(str(out)).attrs["loopsim"]["sweep_config"]["chunk_size"]
+    assert chunk_size == DEFAULT_AUTO_CHUNK_SIZE  # --n auto: small chunks, little lost to SIGKILL
     assert "1 of 1 cases NOT resolved" in (stdout := capsys.readouterr().out)
     assert "a larger --n-max than 8" in stdout
 
