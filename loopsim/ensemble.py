@@ -717,6 +717,20 @@ def _joined(parts):
             pa.concat_tables(snapshots) if snapshots else None)
 
 
+def _write_unfinished(out, fingerprint, piece, parts):
+    """Write the finished tasks {start: (positions, results, snapshots)} of an unfinished
+    piece: those from the piece's start as one shorter piece, each later one on its own."""
+    done = [parts[k] for k in sorted(parts)]
+    prefix, reached = 0, piece.start
+    while prefix < len(done) and done[prefix][0].start == reached:
+        reached = done[prefix][0].stop
+        prefix += 1
+    if prefix:
+        write_piece(out, fingerprint, *_joined(done[:prefix]))
+    for task in done[prefix:]:
+        write_piece(out, fingerprint, *task)
+
+
 def _queue_worker(config, tasks, results, halt):
     """One worker thread of :func:`_run_local`: tasks (piece index, positions) from
     ``tasks`` until it is empty or ``halt`` is set, each on one Numba thread (the kernels
@@ -787,15 +801,7 @@ def _run_local(config, out, fingerprint, pieces, threads, unit, progress, stop):
                 if late_error is None:
                     collect(index, part, output)
             for index, parts in finished.items():
-                done = [parts[k] for k in sorted(parts)]
-                prefix, reached = 0, pieces[index].start  # tasks from the piece's start
-                while prefix < len(done) and done[prefix][0].start == reached:
-                    reached = done[prefix][0].stop
-                    prefix += 1
-                if prefix:
-                    write_piece(out, fingerprint, *_joined(done[:prefix]))
-                for task in done[prefix:]:
-                    write_piece(out, fingerprint, *task)
+                _write_unfinished(out, fingerprint, pieces[index], parts)
     if error is not None:
         raise error
 
