@@ -428,8 +428,10 @@ def check_files_belong(stored, files):
         meta = read_metadata(path)
         if meta.get("sweep_fingerprint") != stored["fingerprint"] or stop > count:
             raise ValueError(f"{path!r} belongs to a different sweep than this one's "
-                             f"configuration ({SWEEP_FILE}); use another --out, or move that "
-                             "file away")
+                             f"configuration ({SWEEP_FILE}; fingerprints "
+                             f"{meta.get('sweep_fingerprint')!r} and {stored['fingerprint']!r}, "
+                             f"positions to {stop} of {count}); use another --out, or move "
+                             "that file away")
         if meta.get("positions") != [start, stop]:
             raise ValueError(f"{path!r} holds other cases than its name says (a renamed "
                              "copy?); move it away")
