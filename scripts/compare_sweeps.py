@@ -19,7 +19,6 @@ spread over the grid, see ``io.case_order``).  Prints, as Markdown:
 import argparse
 import json
 
-import numpy as np
 import pandas as pd
 
 import loopsim
