@@ -144,3 +144,34 @@ def test_radau_fixed_step_order():
         errors.append(np.abs(y - riccati.exact_solution(RATES, y0, 0.8)).max())
     slopes = np.diff(np.log(errors)) / np.diff(np.log(steps))
     assert np.all(slopes > 4.5), (errors, slopes)
+
+
+def test_terminal_precision_script_compares_policies_and_restores_the_method_table(tmp_path, monkeypatch):
+    """scripts/terminal_precision.py swaps the Radau policy in integrators.METHODS for each
+    run: its rows carry the policy asked for, errors against the reference run, and the
+    table holds the default method again afterwards (also on the way out of an error)."""
+    import os
+    import runpy
+    import sys
+
+    import pandas as pd
+
+    out = tmp_path / "tp.parquet"
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    monkeypatch.setattr(sys, "argv", [
+        "terminal_precision.py", "--cases", "60:30:4", "--rtols", "1e-4,1e-6", "--ref-rtol", "1e-8",
+        "--t-end", "0.2", "--newton-maxiter", "6,3", "--out", str(out)])
+    script = runpy.run_path(os.path.join(root, "scripts", "terminal_precision.py"))
+    script["main"]()
+    assert I.METHODS["radau5"] is R.RADAU5
+    rows = pd.read_parquet(out)
+    assert rows["reference"].sum() == 1
+    runs = rows[~rows["reference"]]
+    assert sorted(runs["newton_maxiter"]) == [3, 3, 6, 6]
+    tight = runs[runs["rtol"] == 1e-6]
+    loose = runs[runs["rtol"] == 1e-4]
+    assert (tight["d_aspect"].max() < loose["d_aspect"].max()) and tight["d_aspect"].max() < 1e-5
+    monkeypatch.setattr(sys, "argv", ["terminal_precision.py", "--cases", "60:30:4", "--rtols", "-1"])
+    with pytest.raises(Exception):
+        script["main"]()
+    assert I.METHODS["radau5"] is R.RADAU5
