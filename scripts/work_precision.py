@@ -6,8 +6,8 @@ Two cases:
 * in-plane: g0 = 60, θ0 = 30°, t = 10 (a steady elongated terminal shape);
 * 3D: g0 = 150, θ0 = 60°, over the short window t ≤ 0.5 only: in the 3D
   regime tiny differences grow by orders of magnitude within a fraction of a
-  time unit, so a single trajectory's terminal state is not comparable
-  across tolerances.
+  time unit, so terminal states converge in rtol slowly, and for some cases
+  not at all (scripts/terminal_precision.py measures that at t = 10).
 
 Two errors, kept apart:
 * time discretisation: the same n against an rtol = 1e-12 Radau run (max
