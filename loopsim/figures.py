@@ -31,7 +31,7 @@ import pandas as pd
 from matplotlib.colors import Normalize, TwoSlopeNorm
 
 from . import diagnostics, spectral
-from .plots import PAPER_BAND, REGIME_STYLE, phase_diagram
+from .plots import PAPER_BAND, REGIME_STYLE, order_column, orders_text, phase_diagram
 from .stability import circle, paper
 
 #: Colour map of time in trajectories: light yellow (start) to dark purple (end), as the paper's Fig. 6.
@@ -65,21 +65,6 @@ def centred_curve(x, points=CURVE_POINTS):
     x[:, 0] = 0.0
     s = np.linspace(0.0, 2.0 * np.pi, points + 1)
     return spectral.evaluate(x, s)
-
-
-def order_column(frame):
-    """The column holding each row's truncation order: ``n_used`` (the order its terminal
-    coefficients are at; with ``--n auto`` the highest reached) when present, else ``n``."""
-    return "n_used" if "n_used" in frame and frame["n_used"].notna().all() else "n"
-
-
-def orders_text(frame):
-    """'n = 6' for a fixed-n table, 'n auto (n_used = 12, 16)' for ``--n auto`` rows."""
-    column = order_column(frame)
-    values = ", ".join(str(int(v)) for v in sorted(frame[column].unique()))
-    config = (frame.attrs.get("loopsim", {}) or {}).get("sweep_config", {}) or {}
-    auto = bool(config.get("n_auto")) or (column == "n_used" and bool((frame["n_used"] != frame["n"]).any()))
-    return f"n auto (n_used = {values})" if auto else f"n = {values}"
 
 
 def _regime_style(regime):

@@ -17,6 +17,21 @@ REGIME_STYLE = {
 }
 
 
+def order_column(frame):
+    """The column holding each row's truncation order: ``n_used`` (the order its terminal
+    coefficients are at; with ``--n auto`` the highest reached) when present, else ``n``."""
+    return "n_used" if "n_used" in frame and frame["n_used"].notna().all() else "n"
+
+
+def orders_text(frame):
+    """'n = 6' for a fixed-n table, 'n auto (n_used = 12, 16)' for ``--n auto`` rows."""
+    column = order_column(frame)
+    values = ", ".join(str(int(v)) for v in sorted(frame[column].unique()))
+    config = (frame.attrs.get("loopsim", {}) or {}).get("sweep_config", {}) or {}
+    auto = bool(config.get("n_auto")) or (column == "n_used" and bool((frame["n_used"] != frame["n"]).any()))
+    return f"n auto (n_used = {values})" if auto else f"n = {values}"
+
+
 def _axes(ax, figsize):
     if ax is None:
         fig, ax = plt.subplots(figsize=figsize, constrained_layout=True)
@@ -32,11 +47,12 @@ def phase_diagram(frame, ax=None, paper_band=False):
     """g0 against θ0 coloured by regime (hollow: the case is not resolved at its n, see
     ``ensemble.Thresholds.resolved``), with the curves g0 = 3 q_c / sin θ0 of the
     paper's linear stability (q_c = 14.561, wrong sign) and of the full linearisation of
-    the circle at the sweep's truncation (in-plane q_c ≈ 8.90, out-of-plane ≈ 10.65).
+    the circle at the sweep's largest truncation (``n_used`` for ``--n auto`` rows;
+    in-plane q_c ≈ 8.90, out-of-plane ≈ 10.65).
     ``paper_band``: also the paper's empirical in-plane band q = 10.5 and 18.5 (its Fig. 5)."""
     fig, ax = _axes(ax, (6.6, 4.0))
     q_paper = paper.critical_q(20)
-    order = int(frame["n"].max())
+    order = int(frame[order_column(frame)].max())
     resolved = frame["resolved"] if "resolved" in frame else np.ones(len(frame), bool)
     for regime, style in REGIME_STYLE.items():
         rows = frame[(frame["regime"] == regime) & resolved]
@@ -63,9 +79,8 @@ def phase_diagram(frame, ax=None, paper_band=False):
     ax.set_ylim(0, 1.05 * frame["g0"].max())
     ax.set_xlabel(r"initial tilt $\theta_0$ (deg)")
     ax.set_ylabel(r"$g_0$ (gravity / stiffness)")
-    orders = sorted(frame["n"].unique())
-    ax.set_title(f"sedimentation regimes, n = {', '.join(map(str, orders))}, "
-                 f"t = {frame['t_end'].max():g}", fontsize=10)
+    ax.set_title(f"sedimentation regimes, {orders_text(frame)}, t = {frame['t_end'].max():g}",
+                 fontsize=10)
     ax.legend(fontsize=8, frameon=False, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     return fig
 

@@ -133,6 +133,19 @@ def test_figures_of_n_auto_rows_read_the_coefficients_at_n_used():
     assert any("n auto" in text.get_text() for text in fig.axes[0].get_legend().get_texts())
 
 
+def test_phase_diagram_of_n_auto_rows_names_n_used_and_draws_its_linearisation():
+    """An --n auto table is titled by the orders reached, not by the ladder's start, and its
+    full-linearisation curves are those of the largest n_used."""
+    from loopsim.stability import circle
+
+    title = plots.phase_diagram(auto_table()).axes[0].get_title()
+    assert f"n auto (n_used = {N}, {N + 2})" in title
+    assert f"n = {N}," in plots.phase_diagram(table()).axes[0].get_title()
+    labels = [t.get_text() for t in plots.phase_diagram(auto_table()).axes[0].get_legend().get_texts()]
+    q_in_plane = circle.critical_q(N + 2, "in-plane")
+    assert any(f"q = {q_in_plane:.3f}" in text for text in labels)
+
+
 def test_phase_diagram_paper_band_adds_the_two_empirical_curves():
     frame = table()
     plain = plots.phase_diagram(frame)
