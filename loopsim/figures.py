@@ -381,7 +381,7 @@ def q_and_tilt(frame, thresholds=None, axes=None, reference=None):
     in the paper).  ``reference``: an optional second table (for example resolved runs at
     higher n), drawn with black-edged diamonds."""
     fig, (left, right) = _figure(axes, (1, 2), (10.0, 4.6))
-    thresholds = thresholds or _thresholds(int(frame["n"].max()) if len(frame) else 16)
+    thresholds = thresholds or _thresholds(int(frame[order_column(frame)].max()) if len(frame) else 16)
     q_max = float(max(frame["q0"].max(), frame["q_final"].max())) * 1.05 if len(frame) else 1.0
     left.plot([0, q_max], [0, q_max], color="0.8", lw=0.8, zorder=1)
     right.plot([0, 92], [0, 92], color="0.8", lw=0.8, zorder=1)
@@ -400,8 +400,7 @@ def q_and_tilt(frame, thresholds=None, axes=None, reference=None):
               xlim=(0, 92), ylim=(0, 92))
     handles, labels = left.get_legend_handles_labels()
     fig.legend(handles, labels, fontsize=7, frameon=False, loc="outside lower center", ncol=3)
-    orders = ", ".join(str(v) for v in sorted(frame["n"].unique()))
-    fig.suptitle(f"initial against terminal state, n = {orders}", fontsize=10)
+    fig.suptitle(f"initial against terminal state, {orders_text(frame)}", fontsize=10)
     return fig
 
 
@@ -438,8 +437,7 @@ def aspect_ratio(frame, branch=None, ax=None, reference=None, q_max=None):
                         label=label + (f" (n = {order})" if order else ""), zorder=2)
     ax.set_xlabel(r"terminal $q = g_0 \sin\theta / 3$")
     ax.set_ylabel("terminal aspect ratio (variances)")
-    orders = ", ".join(str(v) for v in sorted(frame["n"].unique()))
-    ax.set_title(f"terminal shape against terminal q, n = {orders}", fontsize=10)
+    ax.set_title(f"terminal shape against terminal q, {orders_text(frame)}", fontsize=10)
     ax.set_ylim(bottom=0.9)
     ax.set_xlim(left=0)
     if q_max is not None:
@@ -472,7 +470,7 @@ def seed_distributions(frames, labels=None, axes=None, bins=12):
     frames = list(frames)
     if not frames:
         raise ValueError("no tables to draw")
-    labels = labels or [f"n = {', '.join(map(str, sorted(f['n'].unique())))}" for f in frames]
+    labels = labels or [orders_text(f) for f in frames]
     fig, (left, right) = _figure(axes, (1, 2), (9.0, 3.4))
     tilt_edges = np.linspace(0, 90, bins + 1)
     ar = np.concatenate([f["aspect_ratio"].to_numpy(float) for f in frames])

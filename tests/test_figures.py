@@ -131,6 +131,9 @@ def test_figures_of_n_auto_rows_read_the_coefficients_at_n_used():
     assert "n auto (n_used = " in fig._suptitle.get_text()
     fig = figures.aspect_ratio(table(), reference=frame)
     assert any("n auto" in text.get_text() for text in fig.axes[0].get_legend().get_texts())
+    # titles name the orders reached (Figs. 7, 8 of an --n auto sweep said "n = 4")
+    assert f"n auto (n_used = {N}, {N + 2})" in figures.q_and_tilt(frame)._suptitle.get_text()
+    assert "n auto (n_used = " in figures.aspect_ratio(frame).axes[0].get_title()
 
 
 def test_phase_diagram_of_n_auto_rows_names_n_used_and_draws_its_linearisation():

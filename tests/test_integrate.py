@@ -172,6 +172,6 @@ def test_terminal_precision_script_compares_policies_and_restores_the_method_tab
     loose = runs[runs["rtol"] == 1e-4]
     assert (tight["d_aspect"].max() < loose["d_aspect"].max()) and tight["d_aspect"].max() < 1e-5
     monkeypatch.setattr(sys, "argv", ["terminal_precision.py", "--cases", "60:30:4", "--rtols", "-1"])
-    with pytest.raises(Exception):
+    with pytest.raises(ValueError, match="rtol"):
         script["main"]()
     assert I.METHODS["radau5"] is R.RADAU5
