@@ -15,6 +15,10 @@ spread over the grid, see ``io.case_order``).  Prints, as Markdown:
   largest moves in tilt and aspect ratio;
 * cost: the sum of ``wall_s`` (core-seconds) and of RHS evaluations, and per-case wall
   time quantiles by ``n_used``.
+
+``--moved FILE.csv`` writes every case that moved (its key, both tilts and aspect
+ratios, the differences), largest move first: with OTHER the same sweep re-run at
+rtol / 10, these are the rows whose terminal tilt is not converged in rtol.
 """
 import argparse
 import json
@@ -45,6 +49,9 @@ def compare(reference, other, tilt_tol, common=False):
     tilt = (both["theta_final_deg_other"] - both["theta_final_deg_ref"]).abs()
     aspect = (both["aspect_ratio_other"] - both["aspect_ratio_ref"]).abs()
     changed = both["regime_ref"] != both["regime_other"]
+    moved = both.assign(d_tilt=tilt, d_aspect=aspect).loc[tilt > tilt_tol, KEY + [
+        "regime_ref", "regime_other", "theta_final_deg_ref", "theta_final_deg_other",
+        "aspect_ratio_ref", "aspect_ratio_other", "d_tilt", "d_aspect"]]
     cross = pd.crosstab(both["regime_ref"], both["regime_other"])
     by_regime = {r: dict(cases=int((both["regime_ref"] == r).sum()),
                          moved=int(((both["regime_ref"] == r) & (tilt > tilt_tol)).sum()))
@@ -52,7 +59,8 @@ def compare(reference, other, tilt_tol, common=False):
     return dict(cases=len(both), cross=cross, changed=int(changed.sum()), moved=int((tilt > tilt_tol).sum()),
                 moved_by_regime=by_regime, tilt_max=float(tilt.max()),
                 aspect_max=float(aspect.max()),
-                changed_cases=both.loc[changed, KEY + ["regime_ref", "regime_other"]])
+                changed_cases=both.loc[changed, KEY + ["regime_ref", "regime_other"]],
+                moved_cases=moved.sort_values("d_tilt", ascending=False, kind="stable"))
 
 
 def markdown(frame, index=True):
@@ -81,6 +89,7 @@ def main():
     parser.add_argument("--common", action="store_true",
                         help="compare only the cases both sweeps hold")
     parser.add_argument("--json", help="also write the numbers to this JSON file")
+    parser.add_argument("--moved", metavar="CSV", help="write the cases that moved to this CSV file")
     args = parser.parse_args()
     reference, other = loopsim.read_results(args.reference), loopsim.read_results(args.other)
     sums = [summary(args.reference, reference), summary(args.other, other)]
@@ -98,6 +107,9 @@ def main():
           f"largest |Δ aspect ratio| {result['aspect_max']:.3g}")
     if result["changed"]:
         print(markdown(result["changed_cases"], index=False))
+    if args.moved:
+        result["moved_cases"].to_csv(args.moved, index=False)
+        print(f"the {result['moved']} cases that moved: {args.moved}")
     for name, frame in ((args.reference, reference), (args.other, other)):
         print(f"\nWall time per case in {name}, by n_used (s):\n")
         print("| n_used | cases | median | 90% | max | sum |\n|--:|--:|--:|--:|--:|--:|")

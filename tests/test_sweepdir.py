@@ -367,3 +367,30 @@ def test_dask_is_imported_only_when_used():
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                             check=True)
     assert result.stdout.strip() == "False"
+
+
+def test_compare_sweeps_lists_the_cases_that_moved(reference, tmp_path, monkeypatch, capsys):
+    """scripts/compare_sweeps.py: cases whose terminal tilt moved by more than --tilt-tol
+    are counted and written to --moved, largest move first; the others are not."""
+    import runpy
+
+    out, frame = reference
+    script = runpy.run_path(os.path.join(os.path.dirname(os.path.dirname(__file__)),
+                                         "scripts", "compare_sweeps.py"))
+    other = frame.copy()
+    other.loc[1, "theta_final_deg"] += 0.5
+    other.loc[4, "theta_final_deg"] -= 2.0
+    other.loc[4, "regime"] = "stable" if frame.loc[4, "regime"] != "stable" else "3d"
+    result = script["compare"](frame, other, tilt_tol=0.1)
+    assert result["moved"] == 2 and result["changed"] == 1
+    moved = result["moved_cases"]
+    assert list(moved["theta0_deg"]) == [frame.loc[4, "theta0_deg"], frame.loc[1, "theta0_deg"]]
+    assert list(moved["g0"]) == [frame.loc[4, "g0"], frame.loc[1, "g0"]]
+    assert moved["d_tilt"].tolist() == pytest.approx([2.0, 0.5])
+    # end to end: a sweep compared with itself moves nothing, and the CSV holds no row
+    csv = tmp_path / "moved.csv"
+    monkeypatch.setattr(sys, "argv", ["compare_sweeps.py", out, out, "--tilt-tol", "0",
+                                      "--moved", str(csv)])
+    script["main"]()
+    assert "0 cases change regime; 0 move" in capsys.readouterr().out
+    assert len(pd.read_csv(csv)) == 0
