@@ -394,3 +394,12 @@ def test_compare_sweeps_lists_the_cases_that_moved(reference, tmp_path, monkeypa
     script["main"]()
     assert "0 cases change regime; 0 move" in capsys.readouterr().out
     assert len(pd.read_csv(csv)) == 0
+    # ... and against the moved copy the CSV holds the two cases, largest move first
+    monkeypatch.setattr(loopsim, "read_results", lambda path: frame if path == out else other)
+    monkeypatch.setattr(sys, "argv", ["compare_sweeps.py", out, "other", "--tilt-tol", "0.1",
+                                      "--moved", str(csv)])
+    script["main"]()
+    assert "1 cases change regime; 2 move" in capsys.readouterr().out
+    written = pd.read_csv(csv)
+    assert list(written["case_id_ref"]) == [frame.loc[4, "case_id"], frame.loc[1, "case_id"]]
+    assert written["d_tilt"].tolist() == pytest.approx([2.0, 0.5])
