@@ -17,10 +17,11 @@ spread over the grid, see ``io.case_order``).  Prints, as Markdown:
 * cost: the sum of ``wall_s`` (core-seconds) and of RHS evaluations, and per-case wall
   time quantiles by ``n_used``.
 
-``--moved FILE.csv`` writes every case that moved (its key, its case_id in each sweep,
-both tilts and aspect ratios, the differences), largest move first: with OTHER the same sweep re-run at
-rtol / 10, these are the rows whose terminal tilt changed by more than --tilt-tol
-with rtol.  Cases whose tilt is missing (failed) in either sweep are not listed.
+``--moved FILE.csv`` writes every case that moved (its key, its case_id in each
+sweep, both tilts and aspect ratios, the differences), largest move first.  With
+OTHER the same sweep re-run at rtol / 10, these are the rows whose terminal tilt
+changed by more than --tilt-tol with rtol.  Cases whose tilt is missing (failed) in
+either sweep are not listed.
 """
 import argparse
 import json
@@ -52,7 +53,8 @@ def compare(reference, other, tilt_tol, common=False):
     aspect = (both["aspect_ratio_other"] - both["aspect_ratio_ref"]).abs()
     changed = both["regime_ref"] != both["regime_other"]
     moved = both.assign(d_tilt=tilt, d_aspect=aspect).loc[tilt > tilt_tol, KEY + [
-        "case_id_ref", "case_id_other", "regime_ref", "regime_other", "theta_final_deg_ref", "theta_final_deg_other",
+        "case_id_ref", "case_id_other", "regime_ref", "regime_other",
+        "theta_final_deg_ref", "theta_final_deg_other",
         "aspect_ratio_ref", "aspect_ratio_other", "d_tilt", "d_aspect"]]
     cross = pd.crosstab(both["regime_ref"], both["regime_other"])
     by_regime = {r: dict(cases=int((both["regime_ref"] == r).sum()),
