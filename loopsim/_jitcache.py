@@ -19,6 +19,7 @@ import os
 import re
 
 import numba
+import numba.core.event
 
 PACKAGE_DIR = os.path.dirname(os.path.abspath(__file__))
 PACKAGE = os.path.basename(PACKAGE_DIR)
@@ -104,3 +105,48 @@ def cache_dir():
 def configure():
     """Point Numba's cache at :func:`cache_dir` (before kernels are decorated)."""
     numba.config.CACHE_DIR = cache_dir()
+    numba.core.event.register("numba:compile", COMPILE_CLOCK)
+
+
+# ---- compilation made visible and kept apart from the work ----------------------------
+class CompileClock(numba.core.event.Listener):
+    """Numba's compile events (cache misses only: a kernel loaded from the cache sends
+    none): the first one prints :data:`NOTICE` on stderr once per process; ``seconds``
+    adds up the time spent in outermost compilations, so callers can report their work
+    without it (``seconds`` before and after, subtracted)."""
+
+    NOTICE = ("loopsim: compiling numerical kernels for first use (cached for later runs; "
+              "about a minute on 2 cores) ...")
+
+    def __init__(self):
+        self.seconds = 0.0
+        self.announced = False
+        self._depth = 0
+        self._started = 0.0
+
+    def on_start(self, event):
+        import sys
+        import time
+
+        if self._depth == 0:
+            if not self.announced and not os.environ.get("LOOPSIM_QUIET_COMPILE"):
+                print(self.NOTICE, file=sys.stderr, flush=True)
+            self.announced = True
+            self._started = time.perf_counter()
+        self._depth += 1
+
+    def on_end(self, event):
+        import time
+
+        self._depth -= 1
+        if self._depth == 0:
+            self.seconds += time.perf_counter() - self._started
+
+
+#: The process's compile clock (registered by :func:`configure`).
+COMPILE_CLOCK = CompileClock()
+
+
+def compile_seconds():
+    """Seconds this process has spent compiling kernels so far (cache misses)."""
+    return COMPILE_CLOCK.seconds

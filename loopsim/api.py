@@ -8,10 +8,12 @@ the arguments ``t_span``, ``t_eval``, ``rtol``, ``atol``, ``method``,
 import dataclasses
 import math
 import time
+import warnings
 
 import numpy as np
 
-from . import diagnostics, integrators, io, models, refinement, shapes, validation
+from . import _jitcache, diagnostics, integrators, io, models, outcomes, refinement, shapes, \
+    validation
 from .config import (
     DEFAULT_ATOL, DEFAULT_LENGTH_TOL, DEFAULT_MAX_STEPS, DEFAULT_N_MAX, DEFAULT_RTOL,
     DEFAULT_SEED, DEFAULT_STEADY_INTERVAL, DEFAULT_T_END, DEFAULT_TAIL_TOL, DEFAULT_W,
@@ -62,6 +64,10 @@ class SimulationResult:
     n_used: int = None
     tail_max: float = float("nan")
     initial_info: dict = None  # diagnostics of a given initial shape (``shapes``), else None
+    aspect_ratio_initial: float = float("nan")
+    twin: dict = None  # the twin's end state and cost (``outcomes``), or None without one
+    compile_s: float = 0.0  # kernel compilation during the call, not counted in wall_s
+    thresholds: outcomes.Thresholds = outcomes.Thresholds()
 
     @property
     def success(self):
@@ -88,12 +94,63 @@ class SimulationResult:
     def y(self):
         return self.x.reshape(self.x.shape[0], -1).T
 
+    @property
+    def end_state(self):
+        """{regime, theta_final_deg, aspect_ratio} of the final state."""
+        return outcomes.end_state(self.inputs["theta0_deg"], self.aspect_ratio_initial,
+                                  self.x_final, self.success, self.thresholds)
+
+    @property
+    def regime(self):
+        return self.end_state["regime"]
+
+    @property
+    def resolved(self):
+        """Whether n_used resolves the run (``outcomes.Thresholds.resolved``)."""
+        return self.thresholds.resolved(self.length_error_max, self.tail_max)
+
+    @property
+    def determinacy(self):
+        """``outcomes.DETERMINACY_FIELDS``: determined (None without a twin), the run–twin
+        differences of terminal tilt and aspect ratio, the twin's RHS evaluations."""
+        if self.twin is None:
+            return dict(outcomes.NO_TWIN)
+        return outcomes.determinacy(self.end_state, self.twin, self.twin["nfev"],
+                                    self.thresholds)
+
+    @property
+    def determined(self):
+        return self.determinacy["determined"]
+
     def __repr__(self):
+        d = self.determinacy
         return (f"SimulationResult(g0={self.inputs['g0']:g}, theta0_deg="
-                f"{self.inputs['theta0_deg']:g}, n={self.inputs['n']}, method={self.method!r}, "
-                f"message={self.message!r}, t_final={self.t_final:g}, times={len(self.t)}, "
-                f"missed={len(self.t_missed)}, nfev={self.nfev}, njev={self.njev}, "
-                f"nlu={self.nlu}, wall_s={self.wall_s:.3g})")
+                f"{self.inputs['theta0_deg']:g}, n_used={self.n_used}, method={self.method!r}, "
+                f"message={self.message!r}, regime={self.regime!r}, resolved={self.resolved}, "
+                f"determined={d['determined']}, theta_final_deg="
+                f"{self.end_state['theta_final_deg']:.4g}, theta_uncertainty_deg="
+                f"{d['theta_uncertainty_deg']:.2g}, t_final={self.t_final:g}, "
+                f"times={len(self.t)}, nfev={self.nfev}, wall_s={self.wall_s:.3g})")
+
+    def warnings(self):
+        """Lines a user should read: the run is not resolved, or not determined."""
+        lines = []
+        if not self.resolved:
+            lines.append(
+                f"not resolved at n = {self.n_used} (length error up to "
+                f"{self.length_error_max:.2g}, limit {self.thresholds.resolved_length_error:g};"
+                f" spectral tail up to {self.tail_max:.2g}, limit "
+                f"{self.thresholds.resolved_tail:g}): the terminal tilt and shape are not "
+                "converged; increase n or use n auto")
+        if self.determined is False:
+            d = self.determinacy
+            lines.append(
+                f"outcome not determined: a twin run at {outcomes.TWIN_FACTOR:g}x stricter "
+                f"tolerances ends {d['theta_uncertainty_deg']:.2g} deg and "
+                f"{d['aspect_uncertainty']:.2g} in aspect ratio away (regime "
+                f"{self.twin['regime']!r}): the terminal tilt is a sample of an "
+                "ill-conditioned transient, not an outcome")
+        return lines
 
     def tension_profile(self, i=None):
         """(s, N(s)) at requested time i, or at the final state (default)."""
@@ -102,26 +159,42 @@ class SimulationResult:
         return diagnostics.tension_profile(self.x[i], self.multiplier[i])
 
     def summary(self):
-        """Dict with exactly the keys of ``SUMMARY_FIELDS`` (the final state's diagnostics)."""
+        """Dict with exactly the keys of ``SUMMARY_FIELDS`` (the final state's diagnostics
+        and what they mean)."""
         return terminal_summary(
             self.inputs, self.x_final, self.u_final, self.multiplier_final,
             method=self.method, n_used=self.n_used,
             status=integrators.STATUS_NAMES[self.status_code], t_final=self.t_final,
             steps_accepted=self.steps_accepted, steps_rejected=self.steps_rejected,
             nfev=self.nfev, njev=self.njev, nlu=self.nlu, wall_s=self.wall_s,
-            tail_max=self.tail_max)
+            tail_max=self.tail_max, regime=self.regime, resolved=self.resolved,
+            **self.determinacy)
 
 
 def terminal_summary(inputs, x, u, multiplier, **run_stats):
     """Summary fields of a final shape x with velocity u and multiplier T.
 
     ``inputs``: g0, theta0_deg, n, t_end, rtol, atol, w, perturbation, seed;
-    ``run_stats``: the ``io.RUN_FIELDS``.
+    ``run_stats``: the ``io.RUN_FIELDS`` and ``io.OUTCOME_FIELDS``.
     """
     values = dict(inputs, **run_stats)
     values["q0"] = stability_parameter(inputs["g0"], inputs["theta0_deg"])
     values.update(diagnostics.evaluate(diagnostics.State(x, u, multiplier, inputs["g0"])))
     return {key: values[key] for key in SUMMARY_FIELDS}
+
+
+def twin_end_state(method, g0, w, x0, t0, t_end, options, ladder, tail_tol, theta0_deg,
+                   thresholds=outcomes.Thresholds()):
+    """The end state of a run's twin (``outcomes``): the same start and method, every
+    tolerance ``outcomes.TWIN_FACTOR`` times stricter.  Returns
+    {regime, theta_final_deg, aspect_ratio, nfev, n_used}."""
+    rtol, atol, tail_tol = outcomes.twin_tolerances(options.rtol, options.atol, tail_tol)
+    status, _, x, n_used, counts, _, _ = refinement.integrate_case(
+        method, g0, w, x0, t0, t_end, np.empty(0), options._replace(rtol=rtol, atol=atol),
+        ladder, tail_tol)
+    end = outcomes.end_state(theta0_deg, diagnostics.aspect_ratio(x0), x,
+                             status in integrators.SUCCESS, thresholds)
+    return dict(end, nfev=int(counts[2]), n_used=int(n_used))
 
 
 def evaluate_maps(x, g0, w=DEFAULT_W):
@@ -143,18 +216,19 @@ def velocity_and_multiplier(problem, x):
 def simulate(
     g0, theta0_deg=None, *, n=None, t_span=(0.0, DEFAULT_T_END), t_eval=None,
     snapshots=2, rtol=DEFAULT_RTOL, atol=DEFAULT_ATOL, w=DEFAULT_W,
-    perturbation=None, seed=DEFAULT_SEED, method="rkf45",
+    perturbation=None, seed=DEFAULT_SEED, method=None,
     max_steps=DEFAULT_MAX_STEPS, length_tol=DEFAULT_LENGTH_TOL, first_step=None,
     max_step=math.inf, min_step=0.0, steady_tol=None, steady_interval=DEFAULT_STEADY_INTERVAL,
     initial=None, initial_case_id=None, n_max=DEFAULT_N_MAX, tail_tol=DEFAULT_TAIL_TOL,
-    n_start=None,
+    n_start=None, twin=True,
 ):
     """Simulate a loop released as a perturbed circle tilted by ``theta0_deg``.
 
     Parameters follow ``scipy.integrate.solve_ivp`` where they overlap:
     ``t_span`` (t0, t_end), ``t_eval`` (the output times, returned exactly;
     default ``snapshots`` equally spaced times including both ends),
-    ``rtol``/``atol``, ``method`` (``integrators.METHODS``), ``first_step``,
+    ``rtol``/``atol``, ``method`` (``integrators.METHODS`` or "auto"; default
+    "rkf45", the paper's scheme, at a fixed n and "auto" with ``n="auto"``), ``first_step``,
     ``max_step``, ``min_step``.  ``steady_tol`` (default off) stops early at a
     steady terminal state (``integrators.step_options``).  ``g0`` is gravity
     over stiffness, ``w`` the length-penalty rate, ``perturbation`` the RMS
@@ -162,7 +236,10 @@ def simulate(
     n = 6).  ``n="auto"`` starts at ``n_start`` (default 6, or a given shape's
     order) and raises n up to ``n_max`` whenever the spectral tail passes ``tail_tol``
     (``loopsim.refinement``).  ``method="auto"`` picks the integrator for the case
-    (``refinement.auto_method``).
+    (``refinement.auto_method``).  ``twin`` (default on) also runs the stricter twin
+    that says whether the outcome is determined (``loopsim.outcomes``; about doubles
+    the cost); ``result.warnings()`` lists what a user should know (also issued as
+    Python warnings).
 
     ``initial`` starts from a given shape instead of the tilted circle:
     coefficients (3, 2m+1) or a path (point file or results, with
@@ -172,8 +249,10 @@ def simulate(
     Never raises for a failed integration: see ``result.success``.
     """
     g0 = validation.check_real("g0", g0, low=0.0)
-    method = validation.check_choice("method", method, refinement.METHOD_CHOICES)
     refine = isinstance(n, str)
+    method = validation.check_choice(
+        "method", ("auto" if refine else "rkf45") if method is None else method,
+        refinement.METHOD_CHOICES)
     tail_tol = validation.check_real("tail_tol", tail_tol, low=0.0, low_open=True)
     if refine:
         validation.check_choice("n", n, ("auto",))
@@ -219,10 +298,16 @@ def simulate(
     options = integrators.step_options(
         rtol, atol, first_step, min_step, max_step, max_steps, length_tol,
         steady_interval if steady_tol is not None else 0.0, steady_tol or 0.0)
+    compiled = _jitcache.compile_seconds()
     start = time.perf_counter()
     status, t_final, x_final, n_used, counts, worst, x_out = refinement.integrate_case(
         method_object, g0, w, x0, t0, t_end, t_eval, options, ladder, tail_tol)
-    wall = time.perf_counter() - start
+    twin_state = twin_end_state(method_object, g0, w, x0, t0, t_end, options, ladder,
+                                tail_tol, theta0_deg) if twin else None
+    compile_s = _jitcache.compile_seconds() - compiled
+    wall = time.perf_counter() - start - compile_s
+    if twin:  # the twin's time is not the run's: split the wall time by RHS evaluations
+        wall *= float(counts[2]) / (counts[2] + twin_state["nfev"])
 
     problem = models.local_sbt.make_problem(n_used, g0, w)
     reached = t_eval <= t_final
@@ -233,9 +318,17 @@ def simulate(
         u[i], multiplier[i] = velocity_and_multiplier(problem, x[i])
     u_final, multiplier_final = velocity_and_multiplier(problem, x_final)
     stats = dict(zip(integrators.COUNTS, (int(c) for c in counts)))
-    return SimulationResult(
+    result = SimulationResult(
         inputs=inputs, method=method, t=t_eval[reached], x=x, u=u, multiplier=multiplier,
         t_missed=t_eval[~reached], t_final=float(t_final), x_final=x_final, u_final=u_final,
         multiplier_final=multiplier_final, status_code=int(status), wall_s=wall,
         length_error_max=float(worst[0]), n_used=int(n_used), tail_max=float(worst[1]),
-        initial_info=initial_info, **stats)
+        initial_info=initial_info, aspect_ratio_initial=diagnostics.aspect_ratio(x0),
+        twin=twin_state, compile_s=compile_s, **stats)
+    for line in result.warnings():
+        warnings.warn(line, LoopsimWarning, stacklevel=2)
+    return result
+
+
+class LoopsimWarning(UserWarning):
+    """A result that needs care: not resolved, or not determined (``SimulationResult.warnings``)."""

@@ -54,6 +54,13 @@ DEFAULT_STEADY_TOL = 1e-6
 #: 0.22° (aspect ratio 3.6e-3) on the 3D and in-plane cases.
 RESOLVED_LENGTH_ERROR = 1e-5
 RESOLVED_TAIL = 1e-5
+#: The spectral tail is measured against the loop's deformation (modes k >= 2), floored at
+#: DEFORMATION_FLOOR times its size (the default perturbation's size): a smaller deformation
+#: counts as that large, so top modes below DEFORMATION_FLOOR * RESOLVED_TAIL = 1e-8 of the
+#: loop's size (ten times the default atol: integration noise) never call for refinement,
+#: and a loop relaxing back to its circle does not climb the ladder on noise.  (At 1e-4,
+#: noise at the atol level tripped the tolerance on stable loops.)
+DEFORMATION_FLOOR = 1e-3
 #: Automatic truncation (``n="auto"``, ``loopsim.refinement``): the orders a case may
 #: climb, the default top order, and the spectral-tail tolerance that sends a case up.
 AUTO_ORDERS = (6, 8, 12, 16, 20, 24, 32, 40, 48, 64)

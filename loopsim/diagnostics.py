@@ -13,6 +13,7 @@ import math
 import numpy as np
 
 from . import spectral
+from .config import DEFORMATION_FLOOR
 
 #: Fine grid points per unit of order for tension profiles and lengths.
 PROFILE_POINTS_PER_ORDER = 64
@@ -39,8 +40,17 @@ def mode_energy(c):
 
 
 def spectral_tail(c, n):
-    """RMS relative amplitude in the modes k ≥ max(2, n - 1) of the series c:
-    sqrt(Σ_{k ≥ max(2, n-1)} E_k / Σ_{k ≥ 1} E_k)."""
+    """Share of the deformation (modes k ≥ 2) carried by the top modes k ≥ max(2, n - 1):
+    sqrt(Σ_{k ≥ max(2, n-1)} E_k / (Σ_{k ≥ 2} E_k + φ² Σ_{k ≥ 1} E_k)), φ the
+    ``config.DEFORMATION_FLOOR`` (below it a loop counts as a circle)."""
+    energy = mode_energy(c)
+    scale = energy[1:].sum() + DEFORMATION_FLOOR**2 * energy.sum()
+    return float(np.sqrt(energy[max(2, n - 1) - 1 :].sum() / scale)) if scale > 0 else 0.0
+
+
+def top_mode_share(c, n):
+    """RMS amplitude of the top modes k ≥ max(2, n - 1) relative to the loop's:
+    sqrt(Σ_{k ≥ max(2, n-1)} E_k / Σ_{k ≥ 1} E_k) (the tail's absolute size)."""
     energy = mode_energy(c)
     total = energy.sum()
     return float(np.sqrt(energy[max(2, n - 1) - 1 :].sum() / total)) if total > 0 else 0.0
@@ -174,7 +184,8 @@ REGISTRY = [
                "(L - 2 pi) / 2 pi"),
     Diagnostic("spectral_tail", lambda s: spectral_tail(s.x, spectral.order_of(s.x.shape[-1])),
                "float64", "spectral_tail",
-               "RMS share of the two top modes kept (k >= max(2, n-1)): large means n too small"),
+               "RMS share of the deformation (modes k >= 2) in the two top modes kept "
+               "(k >= max(2, n-1)): large means n too small"),
 ]
 
 

@@ -15,6 +15,7 @@ tables ``io``.
 """
 import contextlib
 import dataclasses
+import functools
 import itertools
 import json
 import math
@@ -30,51 +31,17 @@ import pandas as pd
 import pyarrow as pa
 
 from . import (
-    api, diagnostics, integrators, io, models, refinement, shapes, spectral, validation,
+    api, diagnostics, integrators, io, models, outcomes, refinement, shapes, spectral,
+    validation,
 )
+from . import _jitcache
 from ._blas import one_blas_thread
 from .config import (
     DEFAULT_ATOL, DEFAULT_CHUNK_SIZE, DEFAULT_LENGTH_TOL, DEFAULT_MAX_STEPS, DEFAULT_N_MAX,
     DEFAULT_PERTURBATION, DEFAULT_RTOL, DEFAULT_STEADY_INTERVAL, DEFAULT_STEADY_TOL,
-    DEFAULT_T_END, DEFAULT_TAIL_TOL, DEFAULT_W, RESOLVED_LENGTH_ERROR, RESOLVED_TAIL,
+    DEFAULT_T_END, DEFAULT_TAIL_TOL, DEFAULT_W,
 )
-
-REGIMES = ("stable", "in-plane", "3d", "failed")
-
-
-@dataclasses.dataclass(frozen=True)
-class Thresholds:
-    """Regime thresholds (paper §6: stable = shape and tilt unchanged; in-plane = shape
-    changed, tilt unchanged; 3d = tilt changed).
-
-    tilt_change_deg: |θ_final − θ0| above which the tilt has changed.
-    shape_change: |aspect ratio_final − aspect ratio_initial| above which the shape has.
-    resolved_length_error, resolved_tail: a case is resolved at its n when its worst
-    transient relative length error and its largest spectral tail along the run stay at
-    or below these (``config.RESOLVED_LENGTH_ERROR``, ``config.RESOLVED_TAIL``).
-    """
-
-    tilt_change_deg: float = 1.0
-    shape_change: float = 0.01
-    resolved_length_error: float = RESOLVED_LENGTH_ERROR
-    resolved_tail: float = RESOLVED_TAIL
-
-    def resolved(self, length_error_max, tail_max):
-        """Whether a case with these diagnostics is resolved at its n."""
-        return bool(length_error_max <= self.resolved_length_error
-                    and tail_max <= self.resolved_tail)
-
-
-def classify(theta0_deg, theta_final_deg, aspect_initial, aspect_final, ok, thresholds=Thresholds()):
-    """Regime label of one case: 'stable', 'in-plane', '3d' or 'failed' (status not ok)."""
-    if not ok:
-        return "failed"
-    if abs(theta_final_deg - theta0_deg) > thresholds.tilt_change_deg:
-        return "3d"
-    if abs(aspect_final - aspect_initial) > thresholds.shape_change:
-        return "in-plane"
-    return "stable"
-
+from .outcomes import REGIMES, Thresholds, classify  # noqa: F401 - re-exported
 
 # ---- the table (schema: io.RESULT_SCHEMA) ----------------------------------
 FIELD_NOTES = {
@@ -94,6 +61,14 @@ FIELD_NOTES = {
                 "along the run at n_used (with --n auto, lower orders were left when their "
                 "tail passed tail_tol)",
     "method": "the integrator that ran the case (--method auto chooses per case)",
+    "determined": "a twin run from the same start with every tolerance 10x stricter ends "
+                  "in the same regime within thresholds.determined_tilt_deg and "
+                  "thresholds.determined_aspect (False: the terminal tilt is a sample of an "
+                  "ill-conditioned transient; null: no twin ran)",
+    "theta_uncertainty_deg": "|theta_final_deg - the twin's|: the terminal tilt's error "
+                             "estimate at the tolerances used (deg)",
+    "aspect_uncertainty": "|aspect_ratio - the twin's|",
+    "twin_nfev": "right-hand-side evaluations of the twin run (0: none ran)",
 }
 
 
@@ -147,6 +122,7 @@ class SweepConfig:
     n_auto: bool = False  # raise n during each run (loopsim.refinement)
     n_max: int = DEFAULT_N_MAX
     tail_tol: float = DEFAULT_TAIL_TOL
+    twin: bool = True  # run each case's stricter twin (loopsim.outcomes: determined or not)
 
     def step_options(self):
         return integrators.step_options(
@@ -320,10 +296,14 @@ def case_ladder(config, case):
 
 
 def _result_row(config, case_id, case, x0, x, status_code, counts, worst, wall_s, t_final,
-                method):
+                method, twin=None):
     """One row of RESULT_SCHEMA for a finished case with final coefficients x (3, 2 n_used + 1);
-    worst = (largest length error, largest spectral tail)."""
+    worst = (largest length error, largest spectral tail); ``twin``: the twin's end state
+    (``api.twin_end_state``) or None."""
     n_used = (x.shape[1] - 1) // 2
+    ok = status_code in integrators.SUCCESS
+    end = outcomes.end_state(case["theta0_deg"], diagnostics.aspect_ratio(x0), x, ok,
+                             config.thresholds)
     if not np.all(np.isfinite(x)):
         x = spectral.resize(x0, n_used)  # keep the row finite; the status says why
     problem = models.local_sbt.make_problem(n_used, case["g0"], config.w)
@@ -332,18 +312,18 @@ def _result_row(config, case_id, case, x0, x, status_code, counts, worst, wall_s
                   t_end=case_option(config, case, "t_end"),
                   rtol=case_option(config, case, "rtol"), atol=config.atol, w=config.w,
                   perturbation=case["perturbation"], seed=case["seed"])
+    determinacy = (dict(outcomes.NO_TWIN) if twin is None else
+                   outcomes.determinacy(end, twin, twin["nfev"], config.thresholds))
     row = api.terminal_summary(
         inputs, x, u, multiplier, method=method, n_used=n_used,
         status=integrators.STATUS_NAMES[status_code], t_final=t_final, wall_s=wall_s,
-        tail_max=float(worst[1]), **dict(zip(integrators.COUNTS, (int(c) for c in counts))))
-    aspect0 = diagnostics.aspect_ratio(x0)
+        tail_max=float(worst[1]), regime=end["regime"],
+        resolved=config.thresholds.resolved(worst[0], worst[1]), **determinacy,
+        **dict(zip(integrators.COUNTS, (int(c) for c in counts))))
     row.update(
-        case_id=case_id, aspect_ratio_initial=aspect0, x_final=x.ravel().tolist(),
-        length_error_max=float(worst[0]), stop_reason=integrators.STOP_REASONS[status_code],
-        resolved=config.thresholds.resolved(worst[0], worst[1]),
-        regime=classify(case["theta0_deg"], row["theta_final_deg"], aspect0, row["aspect_ratio"],
-                        status_code in integrators.SUCCESS, config.thresholds),
-    )
+        case_id=case_id, aspect_ratio_initial=diagnostics.aspect_ratio(x0),
+        x_final=x.ravel().tolist(), length_error_max=float(worst[0]),
+        stop_reason=integrators.STOP_REASONS[status_code])
     return row
 
 
@@ -360,11 +340,12 @@ def _traced_case(config, case_id):
         atol=config.atol, w=config.w,
         method=method, max_steps=config.max_steps, length_tol=config.length_tol,
         steady_tol=config.steady_tol if config.early_stop else None,
-        steady_interval=config.steady_interval, n_max=config.n_max, tail_tol=config.tail_tol)
+        steady_interval=config.steady_interval, n_max=config.n_max, tail_tol=config.tail_tol,
+        twin=config.twin)
     row = _result_row(config, case_id, case, result.x[0], result.x_final, result.status_code,
                       [getattr(result, name) for name in integrators.COUNTS],
                       (result.length_error_max, result.tail_max), result.wall_s,
-                      result.t_final, method)
+                      result.t_final, method, result.twin)
     table = io.trajectory_table(result).replace_schema_metadata(None)
     for name in ("x", "multiplier"):  # orders differ between cases: variable-length lists
         table = table.set_column(table.schema.get_field_index(name), name,
@@ -390,26 +371,43 @@ def run_chunk(config, chunk, threads):
             key = (case["n"], case_method(config, case), case_option(config, case, "rtol"))
             groups.setdefault(key, []).append(case_id)
     start = time.perf_counter()
+    compiled = _jitcache.compile_seconds()
     outputs = []
     for (n, method, rtol), members in sorted(groups.items()):
         cases = [config.cases[i] for i in members]
         x0 = [shapes.start_shape(**_start(c))[0] for c in cases]
-        result = refinement.integrate_cases(
-            integrators.METHODS[method], [(c["g0"], config.w) for c in cases], x0,
+        run = functools.partial(
+            refinement.integrate_cases, integrators.METHODS[method],
+            [(c["g0"], config.w) for c in cases], x0,
             [case_option(config, c, "t_end") for c in cases],
-            config.step_options()._replace(rtol=float(rtol)), case_ladder(config, cases[0]),
-            config.tail_tol,
+            ladder=case_ladder(config, cases[0]),
             cost=[diagnostics.stability_parameter(c["g0"], c["theta0_deg"]) for c in cases])
-        outputs.append((members, x0, method, result))
-    wall = time.perf_counter() - start
-    total_rhs = sum(int(result[4][:, 2].sum()) for *_, result in outputs) or 1
+        options = config.step_options()._replace(rtol=float(rtol))
+        result = run(options=options, tail_tol=config.tail_tol)
+        twins = None
+        if config.twin:
+            twin_rtol, twin_atol, twin_tail = outcomes.twin_tolerances(
+                options.rtol, options.atol, config.tail_tol)
+            twins = run(options=options._replace(rtol=twin_rtol, atol=twin_atol),
+                        tail_tol=twin_tail)
+        outputs.append((members, x0, method, result, twins))
+    wall = time.perf_counter() - start - (_jitcache.compile_seconds() - compiled)
+    total_rhs = sum(int(result[4][:, 2].sum()) + (0 if twins is None else int(twins[4][:, 2].sum()))
+                    for *_, result, twins in outputs) or 1
     rows = {}
-    for members, x0, method, (x_final, _, t_final, status, counts, worst) in outputs:
+    for members, x0, method, (x_final, _, t_final, status, counts, worst), twins in outputs:
         for b, case_id in enumerate(members):
+            case = config.cases[case_id]
+            twin = None
+            if twins is not None:
+                twin = dict(outcomes.end_state(
+                    case["theta0_deg"], diagnostics.aspect_ratio(x0[b]), twins[0][b],
+                    int(twins[3][b]) in integrators.SUCCESS, config.thresholds),
+                    nfev=int(twins[4][b, 2]))
             rows[case_id] = _result_row(
-                config, case_id, config.cases[case_id], x0[b], x_final[b], int(status[b]),
+                config, case_id, case, x0[b], x_final[b], int(status[b]),
                 counts[b], worst[b], wall * threads * counts[b, 2] / total_rhs,
-                float(t_final[b]), method)
+                float(t_final[b]), method, twin)
     snapshots = []
     for case_id in traced:
         rows[case_id], table = _traced_case(config, case_id)
@@ -934,7 +932,8 @@ def config_from_dict(stored):
 
 
 def rerun_failed(out, method, rtol, atol, **backend):
-    """Rerun the failed cases of sweep ``out`` with another method or tolerances.
+    """Rerun the failed cases of sweep ``out`` with another method (None: the sweep's) or
+    tolerances.
 
     Attempt k is a sweep of its own in ``out/_reruns/k`` (the failed cases, the settings
     changed, no snapshots): re-running the same call resumes it.  Once it is complete,
@@ -948,7 +947,7 @@ def rerun_failed(out, method, rtol, atol, **backend):
         raise ValueError(f"no sweep at {out!r} (no {io.SWEEP_FILE}) to rerun failed cases of")
     io.check_layout(out)
     base = config_from_dict(stored["config"])
-    settings = dict(method=method, rtol=rtol, atol=atol)
+    settings = dict(method=method or base.method, rtol=rtol, atol=atol)
     reruns = stored.get("reruns", [])
     open_attempt = next((r for r in reruns if not r["merged"]), None)
     if open_attempt is not None and open_attempt["settings"] != settings:

@@ -38,7 +38,11 @@ INPUT_FIELDS = ("g0", "theta0_deg", "n", "q0", "t_end", "rtol", "atol", "w", "pe
                 "seed")
 RUN_FIELDS = ("method", "n_used", "status", "t_final", "steps_accepted", "steps_rejected",
               "nfev", "njev", "nlu", "wall_s", "tail_max")
-SUMMARY_FIELDS = INPUT_FIELDS + RUN_FIELDS + tuple(d.name for d in diagnostics.REGISTRY)
+#: What the end state means (``loopsim.outcomes``).
+OUTCOME_FIELDS = ("regime", "resolved", "determined", "theta_uncertainty_deg",
+                  "aspect_uncertainty", "twin_nfev")
+SUMMARY_FIELDS = (INPUT_FIELDS + RUN_FIELDS + tuple(d.name for d in diagnostics.REGISTRY)
+                  + OUTCOME_FIELDS)
 
 _FLOAT = pa.float64()
 _INT = pa.int64()
@@ -46,6 +50,7 @@ _SUMMARY_TYPES = {
     "n": _INT, "seed": _INT, "method": pa.string(), "n_used": _INT, "status": pa.string(),
     "steps_accepted": _INT,
     "steps_rejected": _INT, "nfev": _INT, "njev": _INT, "nlu": _INT,
+    "regime": pa.string(), "resolved": pa.bool_(), "determined": pa.bool_(), "twin_nfev": _INT,
     **{d.name: pa.from_numpy_dtype(np.dtype(d.dtype)) for d in diagnostics.REGISTRY},
 }
 #: The declared schema of every sweep chunk (and of :func:`read_results`).
@@ -53,11 +58,9 @@ RESULT_SCHEMA = pa.schema(
     [pa.field("case_id", _INT)]
     + [pa.field(name, _SUMMARY_TYPES.get(name, _FLOAT)) for name in SUMMARY_FIELDS]
     + [
-        pa.field("regime", pa.string()),
         pa.field("stop_reason", pa.string()),
         pa.field("aspect_ratio_initial", _FLOAT),
         pa.field("length_error_max", _FLOAT),
-        pa.field("resolved", pa.bool_()),
         pa.field("x_final", pa.list_(_FLOAT)),
     ]
 )
@@ -225,7 +228,9 @@ def _umask():
 
 def _temporary(directory, suffix):
     """(fd, path) of a new temporary file in ``directory`` named for this host and process,
-    with the mode an ordinary ``open`` gives (0666 less the umask; mkstemp's is 0600)."""
+    with the mode an ordinary ``open`` gives (0666 less the umask; mkstemp's is 0600).
+    The directory is made if absent (output paths are checked before any work)."""
+    os.makedirs(directory, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=_temporary_prefix(), suffix=suffix, dir=directory)
     os.fchmod(fd, 0o666 & ~_umask())
     return fd, tmp

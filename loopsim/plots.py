@@ -3,6 +3,8 @@
 Each function draws into ``ax`` (a new figure when None) and returns the
 figure; none changes the matplotlib backend (the CLI chooses Agg).
 """
+import os
+
 import matplotlib.pyplot as plt
 import numpy as np
 
@@ -113,7 +115,8 @@ def growth_rates(n=16, q_values=None, theta0_deg=90.0, w=None, ax=None):
 
 
 def save(fig, path, dpi=200):
-    """Write ``fig`` to ``path`` and close it."""
+    """Write ``fig`` to ``path`` (its directory made if absent) and close it."""
+    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     fig.savefig(path, dpi=dpi)
     plt.close(fig)
     return path

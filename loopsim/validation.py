@@ -48,18 +48,19 @@ def check_choice(name, value, choices):
 
 
 def check_output_file(name, path):
-    """A file path that can be written: its directory exists and is writable, and the path
-    is not a directory.  Checked before any work, so no run is lost to a bad --out."""
+    """A file path that can be written: not a directory, and its directory exists and is
+    writable or can be made (as ``--out`` directories are: :func:`check_output_directory`).
+    Checked before any work, so no run is lost to a bad path; nothing is created here."""
     path = os.fspath(path)
     if not path:
         raise ValueError(f"{name} is empty")
-    directory = os.path.dirname(os.path.abspath(path))
     if os.path.isdir(path):
         raise ValueError(f"{name} {path!r} is a directory")
-    if not os.path.isdir(directory):
-        raise ValueError(f"{name} {path!r}: no such directory {directory!r}")
-    if not os.access(directory, os.W_OK | os.X_OK):
-        raise ValueError(f"{name} {path!r}: directory {directory!r} is not writable")
+    directory = os.path.dirname(os.path.abspath(path))
+    try:
+        check_output_directory(name, directory)
+    except ValueError as exc:
+        raise ValueError(f"{name} {path!r}: {exc}") from None
     return path
 
 

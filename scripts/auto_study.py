@@ -1,67 +1,87 @@
-"""Convergence study of automatic truncation (``--n auto``): each case's auto run against
-a fixed run at n_used + 8 started from the same curve (the n = 6 start, zero-padded).
+"""Same-start study of ``n="auto"`` and of the determinacy estimate (README, "Automatic
+truncation" and "Determined or not").
 
-    python scripts/auto_study.py --tol 1e-4 [--tol 1e-3 ...] [--cases G0:DEG,...] [--json OUT]
+    python scripts/auto_study.py [--cases G0:DEG[:SEED],...] [--json OUT.jsonl]
 
-Prints one line per (case, tolerance): n_used, terminal tilt and aspect ratio of both
-runs and their differences, the transient length error and spectral tail, RHS counts
-and wall times (radau5, rtol 1e-6, the sweep's early stop at a steady state).
+For each case the start is the tilted circle with its seeded perturbation at n = 6
+(loopsim's default start).  From that one curve, at t = 0:
+
+* ``auto``: ``simulate(n="auto")`` with every default (method auto, twin on);
+* ``ref``: a fixed n = 32 radau5 run at rtol 1e-8, atol 1e-11 (the reference), and a
+  fixed n = 24 run at rtol 1e-8 to show how well the reference itself is converged;
+* ``pert``: ``n="auto"`` again from the start perturbed by 1e-6 (RMS, seed 1), no twin:
+  how far a perturbation at the level of the tolerances moves the outcome.
+
+Prints one line per case: the auto run's n_used, regime, determined flag and its
+estimated tilt uncertainty, its actual distance from the reference (tilt, aspect
+ratio), the reference's own n = 24 / 32 spread, the perturbed start's distance, and
+the costs.  Run without a twin in the reference runs; no early stop (t = 10).
 """
 import argparse
 import json
 import time
+import warnings
 
-import numpy as np
+from loopsim import api, shapes, spectral
 
-from loopsim import diagnostics, integrators, refinement, shapes
-from loopsim.config import DEFAULT_N_MAX, DEFAULT_STEADY_INTERVAL, DEFAULT_STEADY_TOL
+CASES = ",".join([
+    "20:60", "45:60", "60:30", "60:80", "80:45", "80:80", "100:30", "100:45", "100:60",
+    "100:80", "120:30", "120:60", "150:30", "150:45", "150:60", "150:80", "180:30",
+    "180:45", "180:60", "180:80", "200:30", "200:60", "250:30", "250:45", "250:80",
+    "150:60:1", "150:60:2", "200:45:1",
+])
 
-CASES = "30:30,60:30,60:85,100:60,150:45,150:80,250:30,350:60"
+
+def outcome(result):
+    summary = result.summary()
+    return dict(n_used=result.n_used, regime=result.regime, tilt=summary["theta_final_deg"],
+                aspect=summary["aspect_ratio"], nfev=result.nfev, wall_s=result.wall_s,
+                status=result.message)
 
 
-def run(g0, x0, ladder, tol, t_end):
-    options = integrators.step_options(
-        1e-6, 1e-9, max_steps=2_000_000, constraint_tol=0.1,
-        steady_interval=DEFAULT_STEADY_INTERVAL, steady_tol=DEFAULT_STEADY_TOL)
-    start = time.perf_counter()
-    status, t, x, n_used, counts, worst, _ = refinement.integrate_case(
-        integrators.METHODS["radau5"], g0, 10.0, x0, 0.0, t_end, np.empty(0), options, ladder,
-        tol)
-    return dict(status=integrators.STOP_REASONS[status], t_final=t, n_used=int(n_used),
-                tilt=diagnostics.tilt_deg(x), aspect=diagnostics.aspect_ratio(x),
-                length_error_max=float(worst[0]), tail_max=float(worst[1]),
-                nfev=int(counts[2]), wall_s=time.perf_counter() - start)
+def study(g0, theta0, seed):
+    x0 = shapes.start_shape(theta0, 6, None, seed)[0]
+    row = dict(g0=g0, theta0=theta0, seed=seed)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        start = time.perf_counter()
+        auto = api.simulate(g0, initial=x0, perturbation=0.0, n="auto")
+        row["auto_total_s"] = time.perf_counter() - start
+        row["auto"] = outcome(auto)
+        row["auto"].update(determined=auto.determined, **{
+            k: auto.determinacy[k] for k in ("theta_uncertainty_deg", "aspect_uncertainty",
+                                             "twin_nfev")})
+        for n in (24, 32):
+            ref = api.simulate(g0, initial=spectral.resize(x0, n), perturbation=0.0, n=n,
+                               method="radau5", rtol=1e-8, atol=1e-11, twin=False)
+            row[f"ref{n}"] = outcome(ref)
+        pert = api.simulate(g0, initial=x0, perturbation=1e-6, seed=1, n="auto", twin=False)
+        row["pert"] = outcome(pert)
+    return row
+
+
+def line(row):
+    a, r, r24, p = row["auto"], row["ref32"], row["ref24"], row["pert"]
+    return (f"{row['g0']:5g} {row['theta0']:4g} {row['seed']:2d} n_used {a['n_used']:2d} "
+            f"{a['regime']:8s} det {str(a['determined']):5s} est {a['theta_uncertainty_deg']:8.2e}"
+            f" | err {abs(a['tilt'] - r['tilt']):8.2e} ar {abs(a['aspect'] - r['aspect']):8.2e}"
+            f" | ref24-32 {abs(r24['tilt'] - r['tilt']):8.2e} | pert {abs(p['tilt'] - a['tilt']):8.2e}"
+            f" | auto {a['wall_s']:5.1f} s (+twin, total {row['auto_total_s']:5.1f} s)"
+            f" ref32 {r['wall_s']:5.1f} s")
 
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--tol", type=float, action="append", required=True)
     parser.add_argument("--cases", default=CASES)
-    parser.add_argument("--t-end", type=float, default=10.0)
-    parser.add_argument("--n-max", type=int, default=DEFAULT_N_MAX)
-    parser.add_argument("--json")
+    parser.add_argument("--json", help="also append each case as a JSON line to this file")
     args = parser.parse_args()
-    rows = []
-    for item in args.cases.split(","):
-        g0, theta = (float(v) for v in item.split(":"))
-        x0 = shapes.start_shape(theta, 6, 1e-3, 0)[0]
-        for tol in args.tol:
-            auto = run(g0, x0, refinement.orders(6, args.n_max), tol, args.t_end)
-            fixed = run(g0, x0, (auto["n_used"] + 8,), 1.0, args.t_end)
-            row = dict(g0=g0, theta0=theta, tol=tol, auto=auto, fixed=fixed,
-                       d_tilt=abs(auto["tilt"] - fixed["tilt"]),
-                       d_aspect=abs(auto["aspect"] - fixed["aspect"]))
-            rows.append(row)
-            print(f"g0={g0:g} th={theta:g} tol={tol:g}: n_used={auto['n_used']} "
-                  f"tilt {auto['tilt']:.3f}/{fixed['tilt']:.3f} (d {row['d_tilt']:.2e}) "
-                  f"AR {auto['aspect']:.4f}/{fixed['aspect']:.4f} (d {row['d_aspect']:.1e}) "
-                  f"len {auto['length_error_max']:.1e}/{fixed['length_error_max']:.1e} "
-                  f"tail {auto['tail_max']:.1e} stop {auto['status']}/{fixed['status']} "
-                  f"t {auto['t_final']:.2f}/{fixed['t_final']:.2f} nfev {auto['nfev']}/"
-                  f"{fixed['nfev']} wall {auto['wall_s']:.1f}/{fixed['wall_s']:.1f}s", flush=True)
-    if args.json:
-        with open(args.json, "w") as handle:
-            json.dump(rows, handle, indent=1)
+    for spec in args.cases.split(","):
+        parts = spec.split(":")
+        row = study(float(parts[0]), float(parts[1]), int(parts[2]) if len(parts) > 2 else 0)
+        print(line(row), flush=True)
+        if args.json:
+            with open(args.json, "a") as handle:
+                handle.write(json.dumps(row) + "\n")
 
 
 if __name__ == "__main__":

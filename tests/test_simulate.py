@@ -97,7 +97,8 @@ def test_cli_run_json_and_parquet(tmp_path, capsys):
                  "--json", "--out", str(out)])
     assert code == 0
     summary = json.loads(capsys.readouterr().out)
-    assert list(summary) == list(api.SUMMARY_FIELDS)
+    assert list(summary) == list(api.SUMMARY_FIELDS) + ["compile_s"]
+    assert summary.pop("compile_s") >= 0.0  # kernel compilation, not in wall_s
     table = pq.read_table(out)
     assert table.num_rows == 3 and table.column("x").type.list_size == 3 * 13
     meta = io.read_metadata(out)
@@ -106,10 +107,19 @@ def test_cli_run_json_and_parquet(tmp_path, capsys):
 
 
 def test_cli_unwritable_output_is_a_clean_error(tmp_path, capsys):
+    (tmp_path / "afile").write_text("not a directory")
     code = main(["run", "--g0", "10", "--theta0", "30", "--t-end", "0.01",
-                 "--out", str(tmp_path / "missing" / "run.parquet")])
+                 "--out", str(tmp_path / "afile" / "run.parquet")])
     err = capsys.readouterr().err.strip()
-    assert code == 2 and len(err.splitlines()) == 1 and "missing" in err
+    assert code == 2 and len(err.splitlines()) == 1 and "afile" in err
+
+
+def test_cli_output_directories_are_made(tmp_path):
+    """As on a fresh clone, where runs/ does not exist: --out and --figure make their
+    directories (checked before any work, made when written)."""
+    assert main(["run", "--g0", "10", "--theta0", "30", "--t-end", "0.01",
+                 "--out", str(tmp_path / "new" / "deeper" / "run.parquet")]) == 0
+    assert (tmp_path / "new" / "deeper" / "run.parquet").stat().st_size > 0
 
 
 def test_cli_stability_and_module_entry_point():
@@ -170,10 +180,10 @@ def test_trajectory_plot_is_centred_on_the_loop(tmp_path):
 
 
 @pytest.mark.parametrize("argv", [
-    ["run", "--g0", "60", "--theta0", "30", "--out", "{tmp}/missing/run.parquet"],
+    ["run", "--g0", "60", "--theta0", "30", "--out", "{tmp}/afile/run.parquet"],
     ["run", "--g0", "60", "--theta0", "30", "--out", "{tmp}"],
     ["run", "--g0", "60", "--theta0", "30", "--out", ""],
-    ["sweep", "--g0", "60", "--theta0", "30", "--out", "{tmp}/s", "--figure", "{tmp}/missing/p.png"],
+    ["sweep", "--g0", "60", "--theta0", "30", "--out", "{tmp}/s", "--figure", "{tmp}/afile/p.png"],
 ])
 def test_output_paths_are_checked_before_any_work(argv, tmp_path, capsys, monkeypatch):
     """A bad --out or --figure is refused before any integration (one line, exit 2)."""
@@ -184,6 +194,7 @@ def test_output_paths_are_checked_before_any_work(argv, tmp_path, capsys, monkey
 
     monkeypatch.setattr(api, "simulate", no_work)
     monkeypatch.setattr(ensemble, "run_sweep", no_work)
+    (tmp_path / "afile").write_text("a file where a directory is needed")
     argv = [a.replace("{tmp}", str(tmp_path)) for a in argv]
     assert main(argv) == 2
     err = capsys.readouterr().err

@@ -17,7 +17,7 @@ import numba
 import numpy as np
 
 from ..config import JIT
-from ..models import constraint_error, resolution_error, rhs, steady_invariants
+from ..models import constraint_error, resolution_error, resolution_size, rhs, steady_invariants
 
 # ---- status codes: the driver never raises; a run ends with one of these ----
 OK = 0
@@ -166,9 +166,9 @@ def record_start(problem, y, t0, t_out, y_out, options):
 def initial_worst(problem, y):
     """The monitors' record at the start (see :func:`monitor`): no constraint error yet
     (the start's is the user's), no resolution error counted yet, the start's
-    resolution error as the previous one, not rising."""
+    resolution size as the previous one, not rising."""
     worst = np.zeros(4)
-    worst[2] = resolution_error(problem, y)
+    worst[2] = resolution_size(problem, y)
     return worst
 
 
@@ -190,20 +190,21 @@ def monitor(problem, t, y, t_end, options, worst, next_check, previous, quiet):
     """After an accepted step: constraint error, resolution and steady state.
 
     ``worst`` (updated in place) = [largest |constraint error|, largest resolution
-    error once rising, the previous resolution error, rising (0 or 1)].  REFINE
+    error once rising, the previous resolution size, rising (0 or 1)].  REFINE
     comes as soon as the resolution error passes ``options.resolution_tol``; the
-    *record* counts it only from the first accepted step at which it grew, since the
-    decay of a start's own seeded high modes (rate ~k⁴) is the initial condition,
-    not dynamics that outgrew the truncation.  Returns (status or -1 to go on,
+    *record* counts it only from the first accepted step at which its absolute size
+    (``models.resolution_size``) grew, since the decay of a start's own seeded high
+    modes is the initial condition, not dynamics that outgrew the truncation.  Returns (status or -1 to go on,
     next_check, previous, quiet).
     """
     worst[0] = max(worst[0], abs(constraint_error(problem, y)))
     if worst[0] > options.constraint_tol:
         return LENGTH_ERROR, next_check, previous, quiet
     resolution = resolution_error(problem, y)
-    if resolution > worst[2]:
+    size = resolution_size(problem, y)
+    if size > worst[2]:
         worst[3] = 1.0
-    worst[2] = resolution
+    worst[2] = size
     if worst[3] > 0.0:
         worst[1] = max(worst[1], resolution)
     if resolution > options.resolution_tol:

@@ -11,11 +11,12 @@ import numba
 from ..config import JIT
 from . import local_sbt, riccati  # noqa: F401 - importing registers the implementations
 from .base import (
-    auxiliary, constraint_error, for_case, implements, jacobian, resolution_error, rhs,
-    steady_invariants,
+    auxiliary, constraint_error, for_case, implements, jacobian, resolution_error,
+    resolution_size, rhs, steady_invariants,
 )
 
-__all__ = ["rhs", "jacobian", "constraint_error", "resolution_error", "steady_invariants",
+__all__ = ["rhs", "jacobian", "constraint_error", "resolution_error", "resolution_size",
+           "steady_invariants",
            "auxiliary",
            "for_case", "implements", "evaluate", "local_sbt", "riccati"]
 

@@ -33,8 +33,17 @@ def constraint_error(problem, y):
 @generic
 def resolution_error(problem, y):
     """How close the state is to the model's resolution limit (for a loop: the spectral
-    tail, the RMS relative amplitude of its top two Fourier modes); 0 for a model
+    tail, the share of its deformation in its top two Fourier modes); 0 for a model
     without a truncation."""
+    raise NotImplementedError("only callable from jitted code")
+
+
+@generic
+def resolution_size(problem, y):
+    """The absolute size of what :func:`resolution_error` measures (for a loop: the top
+    modes' RMS amplitude relative to the loop's size): while it shrinks, the top modes
+    are the start's own, decaying, and the driver does not count the error; 0 for a
+    model without a truncation."""
     raise NotImplementedError("only callable from jitted code")
 
 

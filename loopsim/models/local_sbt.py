@@ -41,11 +41,11 @@ import numba
 import numpy as np
 
 from .. import spectral
-from ..config import JIT
+from ..config import DEFORMATION_FLOOR, JIT
 from ..linalg import least_squares_affine, least_squares_normal
 from .base import (
-    auxiliary, constraint_error, for_case, implements, jacobian, resolution_error, rhs,
-    steady_invariants,
+    auxiliary, constraint_error, for_case, implements, jacobian, resolution_error,
+    resolution_size, rhs, steady_invariants,
 )
 
 #: Precomputed constant matrices of one truncation order, shared by all cases.
@@ -311,12 +311,37 @@ def relative_length_error(x, ops, ws):
 
 @numba.njit(**JIT)
 def spectral_tail(x):
-    """RMS relative amplitude of the top modes k ≥ max(2, n − 1) of x (3, 2n+1):
+    """Share of the loop's deformation carried by its top modes k ≥ max(2, n − 1), x (3, 2n+1):
 
-        sqrt(Σ_{k ≥ max(2, n-1)} E_k / Σ_{k ≥ 1} E_k),   E_k = ½ Σ_xyz (a_k² + b_k²)
+        sqrt(Σ_{k ≥ max(2, n-1)} E_k / (Σ_{k ≥ 2} E_k + φ² Σ_{k ≥ 1} E_k)),
+        E_k = ½ Σ_xyz (a_k² + b_k²),  φ = ``config.DEFORMATION_FLOOR``
 
-    (the same as ``diagnostics.spectral_tail``; 0 for a point).
+    (the same as ``diagnostics.spectral_tail``; 0 for a point).  Modes k ≥ 2 are what
+    deforms a circle; relative to them, the tail measures what the truncation does to
+    the deformation that a transient amplifies, not to the loop's size.
     """
+    n = (x.shape[1] - 1) // 2
+    first = max(2, n - 1)
+    total = 0.0
+    deformation = 0.0
+    top = 0.0
+    for k in range(1, n + 1):
+        energy = 0.0
+        for c in range(3):
+            energy += x[c, k] ** 2 + x[c, n + k] ** 2
+        total += energy
+        if k >= 2:
+            deformation += energy
+        if k >= first:
+            top += energy
+    scale = deformation + DEFORMATION_FLOOR ** 2 * total
+    return np.sqrt(top / scale) if scale > 0.0 else 0.0
+
+
+@numba.njit(**JIT)
+def top_mode_share(x):
+    """RMS amplitude of the top modes k ≥ max(2, n − 1) of x relative to the loop's,
+    sqrt(Σ_{k ≥ max(2, n-1)} E_k / Σ_{k ≥ 1} E_k): the absolute size of the tail."""
     n = (x.shape[1] - 1) // 2
     first = max(2, n - 1)
     total = 0.0
@@ -513,6 +538,12 @@ def _loop_length_error(problem, y):
 def _loop_tail(problem, y):
     k = y.shape[0] // 3
     return spectral_tail(y.reshape((3, k)))
+
+
+@implements(resolution_size, LoopProblem)
+def _loop_top_share(problem, y):
+    k = y.shape[0] // 3
+    return top_mode_share(y.reshape((3, k)))
 
 
 @implements(steady_invariants, LoopProblem)

@@ -7,8 +7,8 @@ statuses of every registered integrator.
 import collections
 
 from .base import (
-    auxiliary, constraint_error, for_case, implements, jacobian, resolution_error, rhs,
-    steady_invariants,
+    auxiliary, constraint_error, for_case, implements, jacobian, resolution_error,
+    resolution_size, rhs, steady_invariants,
 )
 
 RiccatiProblem = collections.namedtuple("RiccatiProblem", "rates")
@@ -41,6 +41,11 @@ def _no_constraint(problem, y):
 
 @implements(resolution_error, RiccatiProblem)
 def _no_truncation(problem, y):
+    return 0.0
+
+
+@implements(resolution_size, RiccatiProblem)
+def _no_truncation_size(problem, y):
     return 0.0
 
 

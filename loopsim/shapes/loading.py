@@ -10,7 +10,7 @@ Diagnostics (the ``info`` dict returned with every shape):
 
 * ``tilt_deg``, ``aspect_ratio`` of the order-n shape (``diagnostics``);
 * ``length``: the curve's length before rescaling (file units), ``scale``;
-* ``spectral_tail`` (``diagnostics.spectral_tail``) of the fine shape (fitted
+* ``spectral_tail`` (``diagnostics.top_mode_share``) of the fine shape (fitted
   order N, or the stored order of results): the RMS amplitude, relative to
   the loop's, carried by the two top modes kept and everything beyond n.
   Above :data:`TAIL_WARNING` (1e-3, the default perturbation's size) the
@@ -96,7 +96,7 @@ def shape_info(x, fine, n):
     """Diagnostics of the order-n shape x given its finer (or equal) series ``fine``."""
     info = dict(n=int(n), tilt_deg=diagnostics.tilt_deg(x),
                 aspect_ratio=diagnostics.aspect_ratio(x),
-                spectral_tail=diagnostics.spectral_tail(fine, n),
+                spectral_tail=diagnostics.top_mode_share(fine, n),
                 truncation=diagnostics.truncation(fine, n))
     info["warnings"] = []
     if info["spectral_tail"] > TAIL_WARNING:
