@@ -31,7 +31,9 @@ import pandas as pd
 from matplotlib.colors import Normalize, TwoSlopeNorm
 
 from . import diagnostics, spectral
-from .plots import PAPER_BAND, REGIME_STYLE, order_column, orders_text, phase_diagram
+from .plots import (
+    PAPER_BAND, REGIME_STYLE, mark_undetermined, order_column, orders_text, phase_diagram,
+)
 from .stability import circle, paper
 
 #: Colour map of time in trajectories: light yellow (start) to dark purple (end), as the paper's Fig. 6.
@@ -78,8 +80,11 @@ def _resolved(frame):
 
 
 def _scatter_regimes(ax, frame, xcol, ycol, shift=None, size=20, label_suffix=""):
-    """Scatter by regime, resolved filled and unresolved hollow; ``shift``: {regime: dx}."""
+    """Scatter by regime, resolved filled and unresolved hollow, undetermined ringed red
+    (``plots.mark_undetermined``); ``shift``: {regime: dx}."""
     resolved = _resolved(frame)
+    shifted = frame.assign(**{xcol: frame[xcol] + frame["regime"].map(shift or {}).fillna(0.0)})
+    mark_undetermined(ax, shifted, xcol, ycol, size)
     for regime, style in REGIME_STYLE.items():
         mask = (frame["regime"] == regime).to_numpy()
         dx = (shift or {}).get(regime, 0.0)

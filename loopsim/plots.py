@@ -41,13 +41,25 @@ def _axes(ax, figsize):
     return ax.figure, ax
 
 
+def mark_undetermined(ax, frame, xcol, ycol, size=22, shift=0.0):
+    """Ring the rows whose outcome is not determined (``determined`` False: a twin at
+    stricter tolerances ends elsewhere, ``loopsim.outcomes``) in red, one legend entry."""
+    if "determined" not in frame:
+        return
+    rows = frame[frame["determined"].eq(False).to_numpy()]
+    if len(rows):
+        ax.scatter(rows[xcol] + shift, rows[ycol], s=3.2 * size, marker="o", facecolors="none",
+                   edgecolors="#d62728", linewidths=0.9, zorder=4,
+                   label="not determined (twin\nends elsewhere)")
+
+
 #: The paper's empirical edges of the in-plane regime (§6, Figs. 5, 7 and 9), q = g0 sin θ0 / 3.
 PAPER_BAND = (10.5, 18.5)
 
 
 def phase_diagram(frame, ax=None, paper_band=False):
     """g0 against θ0 coloured by regime (hollow: the case is not resolved at its n, see
-    ``ensemble.Thresholds.resolved``), with the curves g0 = 3 q_c / sin θ0 of the
+    ``outcomes.Thresholds.resolved``; ringed red: not determined), with the curves g0 = 3 q_c / sin θ0 of the
     paper's linear stability (q_c = 14.561, wrong sign) and of the full linearisation of
     the circle at the sweep's largest truncation (``n_used`` for ``--n auto`` rows;
     in-plane q_c ≈ 8.90, out-of-plane ≈ 10.65).
@@ -65,6 +77,7 @@ def phase_diagram(frame, ax=None, paper_band=False):
             ax.scatter(rows["theta0_deg"], rows["g0"], s=22, linewidths=1.0, marker=style["marker"],
                        facecolors="none", edgecolors=style["color"],
                        label=f"{style['label']}, not resolved at n")
+    mark_undetermined(ax, frame, "theta0_deg", "g0")
     theta = np.linspace(1.0, 90.0, 300)
     ax.plot(theta, 3 * q_paper / np.sin(np.radians(theta)), "k-", lw=1.2,
             label=f"paper's linear\nstability, q = {q_paper:.3f}")

@@ -52,7 +52,7 @@ def table(rows=12):
             t_end=10.0, theta_final_deg=diagnostics.tilt_deg(x),
             q_final=g * np.sin(np.radians(theta_final)) / 3,
             aspect_ratio=diagnostics.aspect_ratio(x), regime=regime, resolved=bool(i % 3),
-            x_final=x.ravel().tolist()))
+            determined=True, x_final=x.ravel().tolist()))
     return pd.DataFrame(records)
 
 
@@ -286,3 +286,20 @@ def test_plot_trajectory_script_draws_the_loop_near_its_centroid(tiny, tmp_path,
     assert len(lines) == 5
     extent = max(np.abs(line.get_xydata()).max() for line in lines)
     assert 0.5 < extent < 3.0
+
+
+def test_undetermined_rows_are_ringed_in_the_phase_diagram_and_figs_7_8():
+    """Rows whose twin ended elsewhere (determined False) get one red ring each and one
+    legend entry; a table without undetermined rows gets none."""
+    frame = table()
+    assert "determined" in frame and frame["determined"].notna().all()
+    labels = lambda fig: [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    assert not any("not determined" in text for text in labels(plots.phase_diagram(frame)))
+    frame = frame.assign(determined=[False] + [True] * (len(frame) - 1))
+    fig = plots.phase_diagram(frame)
+    assert sum("not determined" in text for text in labels(fig)) == 1
+    rings = [c for c in fig.axes[0].collections if c.get_label().startswith("not determined")]
+    assert len(rings) == 1 and len(rings[0].get_offsets()) == 1
+    assert tuple(rings[0].get_offsets()[0]) == (frame["theta0_deg"].iloc[0], frame["g0"].iloc[0])
+    fig = figures.q_and_tilt(frame)
+    assert any(c.get_label().startswith("not determined") for c in fig.axes[0].collections)
