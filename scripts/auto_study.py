@@ -70,11 +70,33 @@ def line(row):
             f" ref32 {r['wall_s']:5.1f} s")
 
 
+def markdown(rows):
+    """The study as a Markdown table (docs/auto-and-determinacy.md)."""
+    out = ["| g0 | θ0 | seed | n_used | regime | determined | estimate (deg) | error (deg) "
+           "| error, aspect | n = 24 vs 32 (deg) | perturbed start (deg) | auto + twin (s) "
+           "| reference (s) |", "|" + "---|" * 13]
+    for row in rows:
+        a, r, r24, p = row["auto"], row["ref32"], row["ref24"], row["pert"]
+        out.append(
+            f"| {row['g0']:g} | {row['theta0']:g} | {row['seed']} | {a['n_used']} | {a['regime']} "
+            f"| {'yes' if a['determined'] else '**no**'} | {a['theta_uncertainty_deg']:.2g} "
+            f"| {abs(a['tilt'] - r['tilt']):.2g} | {abs(a['aspect'] - r['aspect']):.2g} "
+            f"| {abs(r24['tilt'] - r['tilt']):.2g} | {abs(p['tilt'] - a['tilt']):.2g} "
+            f"| {row['auto_total_s']:.1f} | {r['wall_s']:.1f} |")
+    return "\n".join(out)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cases", default=CASES)
     parser.add_argument("--json", help="also append each case as a JSON line to this file")
+    parser.add_argument("--table", metavar="JSONL",
+                        help="print the Markdown table of a saved study instead of running")
     args = parser.parse_args()
+    if args.table:
+        with open(args.table) as handle:
+            print(markdown([json.loads(line) for line in handle]))
+        return
     for spec in args.cases.split(","):
         parts = spec.split(":")
         row = study(float(parts[0]), float(parts[1]), int(parts[2]) if len(parts) > 2 else 0)
