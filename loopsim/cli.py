@@ -75,11 +75,13 @@ def _add_integration_options(parser):
                         help="skip the twin run at 10x stricter tolerances that says whether "
                         "each outcome is determined (about halves the cost; 'determined' is "
                         "then empty)")
-    parser.add_argument("--n-max", type=int, default=DEFAULT_N_MAX,
-                        help="with --n auto: the highest truncation order a case may reach")
-    parser.add_argument("--tail-tol", type=_real, default=DEFAULT_TAIL_TOL,
-                        help="with --n auto: raise n when the spectral tail (RMS relative "
-                        "amplitude of the top two modes) passes this")
+    parser.add_argument("--n-max", type=int, default=None,
+                        help=f"with --n auto: the highest truncation order a case may reach "
+                        f"(default {DEFAULT_N_MAX})")
+    parser.add_argument("--tail-tol", type=_real, default=None,
+                        help="with --n auto: restart a case at the next order when its "
+                        "spectral tail (the top two modes' share of the deformation) passes "
+                        f"this (default {DEFAULT_TAIL_TOL:g})")
 
 
 def _order(text):
@@ -301,13 +303,33 @@ def _format_initial(info):
         for k in keys if k in info])
 
 
+def _check_auto_options(args, n_start=DEFAULT_N):
+    """--n-max and --tail-tol only with --n auto (refused otherwise: they would do
+    nothing), --n-max not below the ladder's start; then their defaults filled in."""
+    from . import validation
+
+    if args.n != "auto":
+        given = [f"--{k.replace('_', '-')}" for k in ("n_max", "tail_tol")
+                 if getattr(args, k) is not None]
+        if given:
+            raise ValueError(f"{given[0]} applies only with --n auto (it would do nothing "
+                             f"at --n {args.n if args.n is not None else DEFAULT_N})")
+    if args.n_max is not None:
+        validation.check_order("--n-max", args.n_max)
+        if args.n == "auto" and args.n_max < n_start:
+            raise ValueError(f"--n-max {args.n_max} is below the order --n auto starts at "
+                             f"({n_start})")
+    args.n_max = DEFAULT_N_MAX if args.n_max is None else args.n_max
+    args.tail_tol = DEFAULT_TAIL_TOL if args.tail_tol is None else args.tail_tol
+
+
 def _check_run_sizes(args):
     """--n, --n-max and --snapshots within their documented bounds, before any work."""
     from . import validation
 
     if args.n not in (None, "auto"):
         validation.check_order("--n", args.n)
-    validation.check_order("--n-max", args.n_max)
+    _check_auto_options(args)
     validation.check_count("--snapshots", args.snapshots, 1, validation.MAX_SNAPSHOTS,
                            "each is a step end and a stored state")
 
@@ -403,6 +425,7 @@ def _parse_shard(text):
 def _sweep_config(args, ensemble):
     from . import validation
 
+    _check_auto_options(args)
     if args.cases:
         if args.g0 or args.theta0:
             raise ValueError("give either --cases or --g0/--theta0, not both")
@@ -445,7 +468,7 @@ def _check_rerun_options(args):
     defaults = vars(parser.parse_args(["sweep"]))
     ignored = [key for key in ("g0", "theta0", "cases", "n", "seeds", "t_end", "w", "perturbation",
                                "no_early_stop", "snapshots_for", "snapshots", "chunk_size",
-                               "shard", "out")
+                               "shard", "out", "n_max", "tail_tol", "no_twin")
                if getattr(args, key) != defaults[key]]
     if ignored:
         raise ValueError(f"--{ignored[0].replace('_', '-')} does not apply with --rerun-failed "
@@ -645,8 +668,10 @@ def _cmd_stability(args):
 def _cmd_branch(args):
     from .stability import branch
 
-    if args.n < 4:
-        raise ValueError(f"--n must be >= 4, got {args.n}")
+    from . import validation
+
+    validation.check_count("--n", args.n, 4, validation.MAX_BRANCH_N,
+                           "the continuation's cost grows like n^3 per point")
     if not args.q_max > 9.0:
         raise ValueError(f"--q-max must be > 9 (the branch starts at q = 8.9001), got {args.q_max}")
     out = branch.branch_summary(args.n, args.q_max, q_min=0.0)
@@ -673,11 +698,6 @@ def _cmd_figures(args):
     from . import figures
 
     only = [v.strip() for v in args.only.split(",") if v.strip()] if args.only else None
-    if not os.path.isdir(args.sweep_dir):
-        raise ValueError(f"no sweep directory at {args.sweep_dir!r}")
-    if args.dpi < 20:
-        raise ValueError(f"--dpi must be >= 20, got {args.dpi}")
-    os.makedirs(args.out, exist_ok=True)
     written = figures.write_figures(args.sweep_dir, args.paths, args.out, only=only,
                                     gallery_theta0=args.gallery_theta0, branch_n=args.branch_n,
                                     branch=not args.no_branch, dpi=args.dpi)

@@ -21,10 +21,12 @@ import json
 import math
 import os
 import queue
+import re
 import signal
 import sys
 import threading
 import time
+import warnings
 
 import numpy as np
 import pandas as pd
@@ -165,6 +167,23 @@ def _cell(path, row, column, value, integer):
 
 #: Optional per-case columns of a cases file that override the sweep's option.
 CASE_OVERRIDES = ("method", "rtol", "t_end")
+#: Every column a cases file may have.
+CASE_COLUMNS = ("g0", "theta0_deg", "n", "seed", "perturbation", "initial",
+                "initial_case_id") + CASE_OVERRIDES
+
+
+def _check_case_columns(path, names):
+    """One-line ValueError for a duplicate or unknown column of a cases file (pandas
+    renames a CSV's second ``g0`` to ``g0.1``)."""
+    seen = set()
+    for name in names:
+        base = re.sub(r"\.\d+$", "", str(name)) if str(name) not in CASE_COLUMNS else str(name)
+        if base in seen or (base != str(name) and base in CASE_COLUMNS):
+            raise ValueError(f"cases file {path!r} has column {base!r} twice")
+        if base not in CASE_COLUMNS:
+            raise ValueError(f"cases file {path!r} has an unknown column {str(name)!r}; "
+                             f"known: {', '.join(CASE_COLUMNS)}")
+        seen.add(base)
 
 
 def _case_row(path, i, row):
@@ -179,6 +198,9 @@ def _case_row(path, i, row):
         if value is not None and not (isinstance(value, float) and math.isnan(value)):
             case[key] = _cell(path, i, key, value, False)
     method = getattr(row, "method", None)
+    if method is not None and not isinstance(method, str) and not pd.isna(method):
+        raise ValueError(f"cases file {path!r}, row {i}, column method: must be one of "
+                         f"{', '.join(refinement.METHOD_CHOICES)}, got {method!r}")
     if isinstance(method, str) and method.strip():
         if method.strip() not in refinement.METHOD_CHOICES:
             raise ValueError(f"cases file {path!r}, row {i}, column method: must be one of "
@@ -201,16 +223,19 @@ def read_cases_file(path, perturbation=DEFAULT_PERTURBATION, n=6):
         if str(path).endswith(".parquet"):
             import pyarrow.parquet as pq
 
-            rows = pq.ParquetFile(path).metadata.num_rows
+            parquet = pq.ParquetFile(path)
+            rows = parquet.metadata.num_rows
+            names = parquet.schema_arrow.names
             frame = None if rows > limit else pd.read_parquet(path)
         else:
             frame = pd.read_csv(path, nrows=limit + 1)
-            rows = len(frame)
+            rows, names = len(frame), list(frame.columns)
     except Exception as exc:  # noqa: BLE001 - any reader failure is the same user error
         raise ValueError(f"cannot read cases file {path!r}: {exc}".splitlines()[0]) from None
     if rows > limit:
         raise ValueError(f"cases file {path!r} has more than {limit} rows (a sweep's most "
                          "cases)")
+    _check_case_columns(path, names)
     missing = {"g0"} | ({"theta0_deg"} if "initial" not in frame.columns else set())
     missing -= set(frame.columns)
     if missing:
@@ -334,14 +359,16 @@ def _traced_case(config, case_id):
     case = config.cases[case_id]
     method = case_method(config, case)
     start = dict(_start(case), **({"n": "auto", "n_start": case["n"]} if config.n_auto else {}))
-    result = api.simulate(
-        case["g0"], **start, t_span=(0.0, case_option(config, case, "t_end")),
-        snapshots=config.snapshot_count, rtol=case_option(config, case, "rtol"),
-        atol=config.atol, w=config.w,
-        method=method, max_steps=config.max_steps, length_tol=config.length_tol,
-        steady_tol=config.steady_tol if config.early_stop else None,
-        steady_interval=config.steady_interval, n_max=config.n_max, tail_tol=config.tail_tol,
-        twin=config.twin)
+    with warnings.catch_warnings():  # the row says it, and the sweep's summary counts it
+        warnings.simplefilter("ignore", api.LoopsimWarning)
+        result = api.simulate(
+            case["g0"], **start, t_span=(0.0, case_option(config, case, "t_end")),
+            snapshots=config.snapshot_count, rtol=case_option(config, case, "rtol"),
+            atol=config.atol, w=config.w,
+            method=method, max_steps=config.max_steps, length_tol=config.length_tol,
+            steady_tol=config.steady_tol if config.early_stop else None,
+            steady_interval=config.steady_interval, n_max=config.n_max,
+            tail_tol=config.tail_tol, twin=config.twin)
     row = _result_row(config, case_id, case, result.x[0], result.x_final, result.status_code,
                       [getattr(result, name) for name in integrators.COUNTS],
                       (result.length_error_max, result.tail_max), result.wall_s,
@@ -517,7 +544,8 @@ def _duration(seconds):
 class Progress:
     """Progress on stderr: a live line in a terminal; in a log file (not a TTY) one line
     every ``interval`` seconds, and a last one at the end.  Done/total, rate, ETA weighted
-    by :func:`case_weight`, failures.  ``quiet``: nothing."""
+    by :func:`case_weight` (both from the time worked: kernel compilation left out),
+    failures.  ``quiet``: nothing."""
 
     def __init__(self, weights, done_ids, quiet=False, stream=None, interval=30.0):
         self.stream = sys.stderr if stream is None else stream
@@ -526,6 +554,7 @@ class Progress:
         self.weight_left = sum(weights.values()) - sum(weights[i] for i in done_ids)
         self.weight_run, self.cases_run = 0.0, 0
         self.start = self.last = time.perf_counter()
+        self.compiled = _jitcache.compile_seconds()  # compilation is not work: not in the ETA
         self.quiet, self.interval = quiet, interval
         self.live = not quiet and self.stream.isatty()
 
@@ -547,8 +576,9 @@ class Progress:
 
     def _line(self):
         elapsed = time.perf_counter() - self.start
-        rate = self.cases_run / elapsed if elapsed > 0 else 0.0
-        eta = (elapsed * max(self.weight_left, 0.0) / self.weight_run if self.weight_run
+        working = max(elapsed - (_jitcache.compile_seconds() - self.compiled), 1e-9)
+        rate = self.cases_run / working
+        eta = (working * max(self.weight_left, 0.0) / self.weight_run if self.weight_run
                else math.nan)
         return (f"cases {self.done}/{self.total} ({100 * self.done / max(self.total, 1):3.0f}%) "
                 f"{rate:6.2f} case/s elapsed {_duration(elapsed)} ETA {_duration(eta)} "
@@ -942,6 +972,10 @@ def rerun_failed(out, method, rtol, atol, **backend):
     Returns (the results DataFrame, the number of cases rerun).  ``backend``: as for
     :func:`run_sweep` (threads, quiet, scheduler, local_cluster, workers, ...).
     """
+    if method is not None:
+        validation.check_choice("--method", method, refinement.METHOD_CHOICES)
+    validation.check_real("--rtol", rtol, low=0.0, low_open=True)  # before anything is
+    validation.check_real("--atol", atol, low=0.0)  # recorded: a refused rerun leaves no trace
     stored = io.read_sweep_file(out) if os.path.isdir(out) else None
     if stored is None:
         raise ValueError(f"no sweep at {out!r} (no {io.SWEEP_FILE}) to rerun failed cases of")

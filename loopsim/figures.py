@@ -30,7 +30,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.colors import Normalize, TwoSlopeNorm
 
-from . import diagnostics, spectral
+from . import diagnostics, spectral, validation
 from .plots import (
     PAPER_BAND, REGIME_STYLE, mark_undetermined, order_column, orders_text, phase_diagram,
 )
@@ -576,7 +576,8 @@ def write_figures(sweep_dir, others=(), out=".", only=None, gallery_theta0=30.0,
     (a grid at another n: Fig. 9; several seeds of one point: the seed distributions;
     any other: a reference drawn over Figs. 7 and 8, and its own gallery) and run files
     (``loopsim run --out``: Fig. 6 and the tension colouring).  Fig. 3 needs no input.
-    ``only``: a subset of :data:`FIGURE_NAMES`.  Bad input raises ValueError.
+    ``only``: a subset of :data:`FIGURE_NAMES`.  Bad input raises ValueError, before
+    ``out`` (made if absent) is created or anything drawn.
     """
     import os
 
@@ -584,10 +585,14 @@ def write_figures(sweep_dir, others=(), out=".", only=None, gallery_theta0=30.0,
     unknown = only - set(FIGURE_NAMES)
     if unknown:
         raise ValueError(f"unknown figure(s) {sorted(unknown)}; choose from {', '.join(FIGURE_NAMES)}")
+    validation.check_count("dpi", dpi, 20, validation.MAX_DPI, "print quality; the pixel "
+                           "count grows with its square")
+    validation.check_tilt("gallery_theta0", gallery_theta0)
+    validation.check_count("branch_n", branch_n, 4, validation.MAX_BRANCH_N,
+                           "the continuation's cost grows like n^3 per point")
+    validation.check_output_directory("out", out)
     if not os.path.isdir(sweep_dir):
         raise ValueError(f"no sweep directory at {sweep_dir!r}")
-    if not os.path.isdir(out):
-        raise ValueError(f"output directory {out!r} does not exist")
     main = _read_sweep(sweep_dir)
     sweeps, runs = {"grid": [], "seeds": [], "reference": []}, []
     for path in others:
@@ -598,6 +603,7 @@ def write_figures(sweep_dir, others=(), out=".", only=None, gallery_theta0=30.0,
             runs.append((path, *read_run(path)))
         else:
             raise ValueError(f"no such file or directory: {path!r}")
+    os.makedirs(out, exist_ok=True)
     written = {}
 
     def save(name, fig):

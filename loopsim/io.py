@@ -336,13 +336,17 @@ def read_table_checked(path, require_hash=False):
         lines = str(exc).strip().splitlines()
         raise DamagedFile(path, f"unreadable: {lines[0] if lines else type(exc).__name__}") \
             from None
-    meta = {_text(k): _text(v) for k, v in (table.schema.metadata or {}).items()}
-    stored = meta.get(CONTENT_KEY)
+    try:  # a flipped bit in the footer may leave names or metadata undecodable
+        meta = {_text(k): _text(v) for k, v in (table.schema.metadata or {}).items()}
+        stored = meta.get(CONTENT_KEY)
+        matches = stored is not None and content_hash(table, meta) == stored
+    except Exception as exc:  # noqa: BLE001 - anything unreadable in a file we wrote is damage
+        raise DamagedFile(path, f"unreadable: {type(exc).__name__}: {str(exc)[:80]}") from None
     if stored is None:
         if require_hash:
             raise DamagedFile(path, f"no {CONTENT_KEY} in its metadata")
         return table
-    if content_hash(table, meta) != stored:
+    if not matches:
         raise DamagedFile(path, "content does not match its checksum")
     return table
 
@@ -501,7 +505,8 @@ def read_results(out):
     stored = read_sweep_file(out)
     if stored is None:
         if not files:
-            return RESULT_SCHEMA.empty_table().to_pandas()
+            raise ValueError(f"{out!r} is not a sweep directory (no {SWEEP_FILE}, no result "
+                             "files): give the directory a sweep's --out named")
         raise ValueError(f"{out!r} has result files but no {SWEEP_FILE} (the sweep's "
                          "configuration): re-run the sweep's command to restore it")
     tables = {}

@@ -90,6 +90,15 @@ MAX_CASES_FILE_BYTES = 256 * 2**20
 MAX_RESULTS_FILE_BYTES = 2**30
 
 
+#: Largest order of the steady branch (``loopsim branch --n``, ``figures --branch-n``): the
+#: continuation solves dense Newton systems of size ~6n at every point of the branch, so
+#: its cost grows like n^3 per point; beyond 48 one branch takes hours.
+MAX_BRANCH_N = 48
+#: Largest figure resolution: 1200 dpi is print quality; a 6 x 4 inch figure is then
+#: 35 megapixels, and 10^6 dpi would ask matplotlib for terapixels.
+MAX_DPI = 1200
+
+
 def check_order(name, value):
     """A truncation order 1 <= n <= MAX_N, as int."""
     value = check_integer(name, value, 1)

@@ -142,6 +142,31 @@ def test_random_bit_flips_are_detected_or_harmless(sweep, pristine):
     assert "detected" in outcomes
 
 
+def test_every_footer_bit_flip_is_damage_or_harmless(sweep):
+    """Flips in the footer (column names, metadata, the Arrow schema) either leave the
+    table as written or make the file damaged: never another exception (a flip that
+    leaves a name undecodable raised UnicodeDecodeError past the checks)."""
+    path = os.path.join(sweep, io.CHUNK_PATTERN.format(0, 1))
+    original = open(path, "rb").read()
+    expected = io.read_table_checked(path)
+    footer = int.from_bytes(original[-8:-4], "little")
+    outcomes = {"harmless": 0, "damaged": 0}
+    for offset in range(len(original) - 8 - footer, len(original) - 8, 5):
+        for bit in (0, 7):
+            data = bytearray(original)
+            data[offset] ^= 1 << bit
+            with open(path, "wb") as handle:
+                handle.write(bytes(data))
+            try:
+                table = io.read_table_checked(path)
+            except io.DamagedFile:
+                outcomes["damaged"] += 1
+                continue
+            assert table.equals(expected), (offset, bit)
+            outcomes["harmless"] += 1
+    assert outcomes["damaged"] > 100 and outcomes["harmless"] > 100, outcomes
+
+
 def test_file_without_its_checksum_is_damaged(sweep):
     """A result file rewritten without the content hash (or a flip that hid its key) is
     not trusted in a sweep that writes checksums."""
@@ -226,13 +251,50 @@ def _point_file(path, rows):
     (["sweep", "--g0", "10", "--theta0", "30", "--out", ""], ["--out is empty"]),
     (["stability", "--paper", "--n-max", "100000"], ["--n-max", "100000"]),
     (["stability", "--n", "100000"], ["--n", "100000"]),
+    (["branch", "--n", "129"], ["--n", "at most 48", "129"]),
+    (["figures", "{tmp}/s", "--out", "{tmp}/figs", "--branch-n", "500"], ["branch_n", "500"]),
+    (["figures", "{tmp}/s", "--out", "{tmp}/figs", "--branch-n", "2"], ["branch_n", "2"]),
+    (["figures", "{tmp}/s", "--out", "{tmp}/figs", "--dpi", "1000000"], ["dpi", "1000000"]),
+    (["figures", "{tmp}/s", "--out", "{tmp}/figs", "--only", "bogus"], ["bogus"]),
+    (["figures", "{tmp}/s", "--out", "{tmp}/figs", "--gallery-theta0", "200"],
+     ["gallery_theta0", "200"]),
+    (["run", "--g0", "60", "--theta0", "30", "--n-max", "40"], ["--n-max applies only"]),
+    (["run", "--g0", "60", "--theta0", "30", "--tail-tol", "1e-4"], ["--tail-tol applies"]),
+    (["sweep", "--g0", "10", "--theta0", "30", "--tail-tol", "1e-4", "--out", "{tmp}/s"],
+     ["--tail-tol applies only"]),
+    (["sweep", "--g0", "10", "--theta0", "30", "--n", "auto", "--n-max", "4", "--out",
+      "{tmp}/s"], ["--n-max 4 is below", "6"]),
 ])
 def test_sizes_refused_in_one_line_before_work(tmp_path, capsys, argv, words):
     argv = [a.replace("{tmp}", str(tmp_path)) for a in argv]
     assert main(argv) == 2
     err = capsys.readouterr().err
     assert len(err.splitlines()) == 1 and all(w in err for w in words), err
+    assert not (tmp_path / "s").exists() and not (tmp_path / "figs").exists()
+
+
+@pytest.mark.parametrize("header, rows, words", [
+    ("g0,theta0_deg,method", ["10,30,3"], ["column method", "3"]),
+    ("g0,theta0_deg,colour", ["10,30,red"], ["unknown column 'colour'"]),
+    ("g0,theta0_deg,g0", ["10,30,20"], ["column 'g0' twice"]),
+])
+def test_cases_file_columns_checked(tmp_path, capsys, header, rows, words):
+    path = tmp_path / "cases.csv"
+    path.write_text(header + "\n" + "\n".join(rows) + "\n")
+    assert main(["sweep", "--cases", str(path), "--out", str(tmp_path / "s")]) == 2
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1 and all(w in err for w in words), err
     assert not (tmp_path / "s").exists()
+
+
+def test_refused_rerun_options_leave_the_directory_usable(sweep, capsys):
+    """An invalid --rtol or --atol of --rerun-failed is refused before anything is
+    recorded in _sweep.json, so a later valid rerun is not blocked by it."""
+    before = open(os.path.join(sweep, io.SWEEP_FILE)).read()
+    for bad in (["--rtol", "0"], ["--atol", "-1"]):
+        assert main(["sweep", "--rerun-failed", sweep, "--quiet"] + bad) == 2
+        assert open(os.path.join(sweep, io.SWEEP_FILE)).read() == before
+    assert main(["sweep", "--rerun-failed", sweep, "--method", "radau5", "--quiet"]) == 0
 
 
 def test_point_files_bounded_by_size_rows_and_kind(tmp_path, capsys):

@@ -48,7 +48,8 @@ def integrate(method, problem, y0, t0, t_end, t_out, options, y_out):
     steps).  Rows of y_out for times not reached are left untouched.
 
     Returns (status, t, y, counts, worst): counts (int64) = [accepted steps,
-    rejected steps, RHS evaluations, Jacobian evaluations, LU factorisations]
+    rejected steps, RHS evaluations of the steps (dense output's are not counted), Jacobian
+    evaluations, LU factorisations]
     (``COUNTS``); worst[:2] = [largest |constraint_error| at the accepted steps,
     largest resolution_error at the accepted steps once it has started to grow]
     (``control.monitor``; worst[2:] is the monitor's state) (for a loop: the worst transient relative length
@@ -104,9 +105,10 @@ def integrate(method, problem, y0, t0, t_end, t_out, options, y_out):
         while i_out < t_out.shape[0] and t_out[i_out] <= t:
             if t_out[i_out] == t:
                 y_out[i_out] = y
-            else:
-                n_rhs += dense_output(method, work, problem, y_old, f_old, y, f, h_try,
-                                      (t_out[i_out] - t_old) / h_try, y_out[i_out])
+            else:  # its evaluations are output's, not the step's: not in nfev, so asking
+                # for output changes no count (a sweep's traced rows equal the others)
+                dense_output(method, work, problem, y_old, f_old, y, f, h_try,
+                             (t_out[i_out] - t_old) / h_try, y_out[i_out])
             i_out += 1
         stop, next_check, previous, quiet = monitor(
             problem, t, y, t_end, options, worst, next_check, previous, quiet)
