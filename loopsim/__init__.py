@@ -12,8 +12,12 @@ Layout (each layer imports only those above it):
 * ``io``: table schemas, Parquet writing and reading;
 * ``api`` (``simulate``), ``ensemble`` (sweeps), ``plots``, ``cli``.
 """
-from . import _jitcache
-from ._version import __version__
+from . import _signals
+
+_signals.install_early()  # the loopsim program: Ctrl-C while loading is one line, exit 130
+
+from . import _jitcache  # noqa: E402
+from ._version import __version__  # noqa: E402
 
 _jitcache.configure()  # before any kernel is decorated: see loopsim/_jitcache.py
 

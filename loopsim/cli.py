@@ -493,8 +493,12 @@ def _cmd_sweep(args):
     if args.threads is not None and not 1 <= args.threads <= numba.config.NUMBA_NUM_THREADS:
         raise ValueError(f"--threads must be in 1..{numba.config.NUMBA_NUM_THREADS} (the "
                          f"cores Numba may use), got {args.threads}")
-    if args.workers is not None and (args.workers < 1 or not args.dask):
-        raise ValueError(f"--workers needs --dask and must be >= 1, got {args.workers}")
+    if args.workers is not None:
+        if not args.dask:
+            raise ValueError(f"--workers needs --dask, got --workers {args.workers} without it")
+        validation.check_count("--workers", args.workers, 1, validation.MAX_WORKERS,
+                               "this machine's cores: each worker is a process that compiles "
+                               "its own kernels, and more than the cores only compete")
     if args.scheduler is not None and args.dask:
         raise ValueError("give --scheduler ADDRESS or --dask, not both")
     if not args.progress_every > 0:

@@ -557,6 +557,7 @@ class Progress:
         self.compiled = _jitcache.compile_seconds()  # compilation is not work: not in the ETA
         self.quiet, self.interval = quiet, interval
         self.live = not quiet and self.stream.isatty()
+        self.printed = None  # the last line written to a log (not repeated by close)
 
     def update(self, case_ids, failures):
         self.done += len(case_ids)
@@ -570,7 +571,8 @@ class Progress:
             self.stream.write("\r" + self._line())
             self.stream.flush()
         elif not self.quiet and now - self.last >= self.interval:
-            self.stream.write(self._line() + "\n")
+            self.printed = self._line()
+            self.stream.write(self.printed + "\n")
             self.stream.flush()
             self.last = now
 
@@ -585,8 +587,9 @@ class Progress:
                 f"failures {self.failures}")
 
     def close(self):
-        if not self.quiet:
-            self.stream.write(("\r" if self.live else "") + self._line() + "\n")
+        line = self._line()
+        if not self.quiet and (self.live or line != self.printed):
+            self.stream.write(("\r" if self.live else "") + line + "\n")
             self.stream.flush()
 
 
@@ -842,7 +845,15 @@ def _dask_client(scheduler, workers):
     from dask.distributed import Client, LocalCluster
 
     if scheduler is not None:
-        return Client(scheduler, timeout="30s"), None
+        if not re.fullmatch(r"(\w+://)?[^\s:/]+:\d+", str(scheduler)):
+            raise ValueError(f"--scheduler must be an address like tcp://host:8786, got "
+                             f"{scheduler!r}")
+        try:
+            return Client(scheduler, timeout="30s"), None
+        except (OSError, ValueError, TypeError) as exc:
+            raise ValueError(f"cannot connect to the Dask scheduler {scheduler!r}: "
+                             f"{str(exc).splitlines()[0] if str(exc) else type(exc).__name__}"
+                             ) from None
     # NUMBA_NUM_THREADS is left alone: a worker process that compiles re-reads it and
     # refuses a value other than the one its thread pool started with (seen with env=
     # here); each task sets its own thread count instead (run_piece)
@@ -921,31 +932,39 @@ def run_sweep(config, out, threads=None, quiet=False, command_line=None, *, sche
     for name, value in (("threads", threads), ("unit", unit)):
         if value is not None:
             validation.check_integer(name, value, 1)
-    fingerprint = _prepare_directory(out, config, command_line or [])
-    covered = io.chunk_files(out)
-    pieces = pending_pieces(config, covered, shard)
-    mine = _covered_ids(config, [(c.start, c.stop) for k, c in enumerate(canonical_chunks(config))
-                                 if shard is None or k % shard[1] == shard[0]])
-    done = set(_covered_ids(config, covered)) & set(mine)
-    progress = Progress({i: case_weight(config.cases[i], config.n_auto) for i in mine}, done,
-                        quiet, stream, progress_interval)
+    if workers is not None:
+        validation.check_count("workers", workers, 1, validation.MAX_WORKERS,
+                               "this machine's cores: each worker is a process that compiles "
+                               "its own kernels, and more than the cores only compete")
+    client = cluster = None
     stop = stop_event()
-    with _stop_on_signals(stop):
-        if distributed and pieces:
-            workers = workers or max(1, numba.config.NUMBA_NUM_THREADS // (threads or 1))
-            client, cluster = _dask_client(scheduler, workers)
-            try:
+    if distributed:  # connected first: a scheduler refused leaves no directory behind
+        workers = workers or max(1, numba.config.NUMBA_NUM_THREADS // (threads or 1))
+        client, cluster = _dask_client(scheduler, workers)
+    try:
+        fingerprint = _prepare_directory(out, config, command_line or [])
+        covered = io.chunk_files(out)
+        pieces = pending_pieces(config, covered, shard)
+        mine = _covered_ids(config, [(c.start, c.stop)
+                                     for k, c in enumerate(canonical_chunks(config))
+                                     if shard is None or k % shard[1] == shard[0]])
+        done = set(_covered_ids(config, covered)) & set(mine)
+        progress = Progress({i: case_weight(config.cases[i], config.n_auto) for i in mine},
+                            done, quiet, stream, progress_interval)
+        with _stop_on_signals(stop):
+            if distributed and pieces:
                 _run_dask(config, out, fingerprint, pieces, threads or (1 if cluster else None),
                           progress, stop, client, write)
-            finally:
-                grace = 1 if stop.is_set() else None  # on a signal: no waiting for tasks
-                client.close(**({} if grace is None else dict(timeout=grace)))
-                if cluster is not None:
-                    _close_cluster(cluster, grace)
-        elif pieces:
-            threads = threads or numba.config.NUMBA_NUM_THREADS
-            _run_local(config, out, fingerprint, pieces, threads, unit or 1, progress,
-                       stop)
+            elif pieces:
+                threads = threads or numba.config.NUMBA_NUM_THREADS
+                _run_local(config, out, fingerprint, pieces, threads, unit or 1, progress,
+                           stop)
+    finally:
+        if client is not None:
+            grace = 1 if stop.is_set() else None  # on a signal: no waiting for tasks
+            client.close(**({} if grace is None else dict(timeout=grace)))
+            if cluster is not None:
+                _close_cluster(cluster, grace)
     progress.close()
     if stop.is_set():
         raise SweepInterrupted(stop.signum, out, progress.done, progress.total)

@@ -94,6 +94,9 @@ MAX_RESULTS_FILE_BYTES = 2**30
 #: continuation solves dense Newton systems of size ~6n at every point of the branch, so
 #: its cost grows like n^3 per point; beyond 48 one branch takes hours.
 MAX_BRANCH_N = 48
+#: Most worker processes of a local Dask cluster: this machine's cores.  Each worker is a
+#: process (about 320 MB) that compiles its own kernels; more than the cores only compete.
+MAX_WORKERS = os.cpu_count() or 1
 #: Largest figure resolution: 1200 dpi is print quality; a 6 x 4 inch figure is then
 #: 35 megapixels, and 10^6 dpi would ask matplotlib for terapixels.
 MAX_DPI = 1200
