@@ -14,6 +14,7 @@ import sys
 import warnings
 
 from ._version import __version__
+from .validation import ENVIRONMENT_ERRNOS
 from .config import (
     DEFAULT_ATOL, DEFAULT_AUTO_CHUNK_SIZE, DEFAULT_CHUNK_SIZE, DEFAULT_N, DEFAULT_N_MAX,
     DEFAULT_PERTURBATION, DEFAULT_RTOL, DEFAULT_SEED, DEFAULT_T_END, DEFAULT_TAIL_TOL, DEFAULT_W,
@@ -25,8 +26,7 @@ EXIT_FAILED_RUN = 1
 EXIT_USAGE = 2
 EXIT_ENVIRONMENT = 3
 #: OSError numbers that are the machine's fault, not the input's: exit EXIT_ENVIRONMENT.
-ENVIRONMENT_ERRORS = {errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EIO, errno.ENOMEM,
-                      errno.EMFILE, errno.ENFILE}
+ENVIRONMENT_ERRORS = ENVIRONMENT_ERRNOS
 
 
 class _HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):

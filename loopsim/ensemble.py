@@ -587,8 +587,10 @@ class Progress:
                 f"failures {self.failures}")
 
     def close(self):
+        if self.quiet:
+            return
         line = self._line()
-        if not self.quiet and (self.live or line != self.printed):
+        if self.live or line != self.printed:
             self.stream.write(("\r" if self.live else "") + line + "\n")
             self.stream.flush()
 

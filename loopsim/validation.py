@@ -1,4 +1,5 @@
 """Input checks shared by every entry point: one-line ``ValueError``s naming the value."""
+import errno
 import math
 import numbers
 import os
@@ -56,11 +57,7 @@ def check_output_file(name, path):
         raise ValueError(f"{name} is empty")
     if os.path.isdir(path):
         raise ValueError(f"{name} {path!r} is a directory")
-    directory = os.path.dirname(os.path.abspath(path))
-    try:
-        check_output_directory(name, directory)
-    except ValueError as exc:
-        raise ValueError(f"{name} {path!r}: {exc}") from None
+    check_output_directory(name, os.path.dirname(os.path.abspath(path)))
     return path
 
 
@@ -137,22 +134,46 @@ def check_input_file(name, path, max_bytes):
     return path
 
 
+#: OSError numbers that are the machine's fault, not the input's (the CLI exits 3 on them).
+ENVIRONMENT_ERRNOS = {errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EIO, errno.ENOMEM,
+                      errno.EMFILE, errno.ENFILE}
+
+
+def _probe_writable(name, path, directory):
+    """Create and remove a file in ``directory``: the one sure test that it takes files
+    (os.access passes a read-only filesystem, /proc and, for root, any mode bits).  A
+    machine's refusal (read-only filesystem, full disk) is re-raised as OSError naming
+    ``path``; any other refusal is a one-line ValueError."""
+    import tempfile
+
+    try:
+        fd, probe = tempfile.mkstemp(prefix=".loopsim-probe-", dir=directory)
+        os.close(fd)
+        os.remove(probe)
+    except OSError as exc:
+        reason = exc.strerror or type(exc).__name__
+        if exc.errno in ENVIRONMENT_ERRNOS:
+            raise OSError(exc.errno, f"{name} {path!r}: {directory!r} takes no files: "
+                                     f"{reason}") from None
+        raise ValueError(f"{name} {path!r}: {directory!r} takes no files: {reason}") from None
+
+
 def check_output_directory(name, path):
-    """A directory that exists and is writable, or can be made (its nearest existing parent
-    is a writable directory): checked before any work."""
+    """A directory that exists and takes files, or can be made (its nearest existing
+    parent is a directory that takes files): checked before any work, by creating and
+    removing a probe file; nothing else is created."""
     path = os.fspath(path)
     if not path.strip():
         raise ValueError(f"{name} is empty")
     if os.path.exists(path):
         if not os.path.isdir(path):
             raise ValueError(f"{name} {path!r} is not a directory")
-        if not os.access(path, os.W_OK | os.X_OK):
-            raise ValueError(f"{name} {path!r} is not writable")
+        _probe_writable(name, path, path)
         return path
     parent = os.path.dirname(os.path.abspath(path))
     while not os.path.exists(parent):
         parent = os.path.dirname(parent)
-    if not os.path.isdir(parent) or not os.access(parent, os.W_OK | os.X_OK):
-        raise ValueError(f"{name} {path!r} cannot be made: {parent!r} is not a writable "
-                         "directory")
+    if not os.path.isdir(parent):
+        raise ValueError(f"{name} {path!r} cannot be made: {parent!r} is not a directory")
+    _probe_writable(name, path, parent)
     return path

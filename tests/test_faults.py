@@ -453,6 +453,35 @@ def test_disk_full_is_an_environment_error_and_the_sweep_resumes(tmp_path, capsy
     assert len(loopsim.read_results(str(out))) == 2
 
 
+def test_output_that_takes_no_files_is_refused_before_work(tmp_path, capsys, monkeypatch):
+    """--out under /proc is an input error (exit 2) found before integrating; a
+    read-only filesystem is the machine's (exit 3); one line each, nothing left."""
+    from loopsim import api
+
+    def no_work(*args, **kwargs):
+        raise AssertionError("integration started before the output path was checked")
+
+    monkeypatch.setattr(api, "simulate", no_work)
+    if os.path.isdir("/proc"):
+        assert main(["run", "--g0", "60", "--theta0", "30", "--out", "/proc/x.parquet"]) == 2
+        err = capsys.readouterr().err
+        assert len(err.splitlines()) == 1 and "/proc" in err and "takes no files" in err, err
+
+    import errno
+    import tempfile
+
+    def read_only(*args, **kwargs):
+        raise OSError(errno.EROFS, "Read-only file system")
+
+    monkeypatch.setattr(tempfile, "mkstemp", read_only)
+    for argv in (["run", "--g0", "60", "--theta0", "30", "--out", str(tmp_path / "r.parquet")],
+                 ["sweep", "--g0", "60", "--theta0", "30", "--out", str(tmp_path / "s")]):
+        assert main(argv) == 3
+        err = capsys.readouterr().err
+        assert len(err.splitlines()) == 1 and "Read-only file system" in err, err
+    assert os.listdir(tmp_path) == []
+
+
 def test_perturbation_larger_than_the_loop_is_refused(tmp_path, capsys):
     from loopsim.cli import main
 

@@ -263,3 +263,30 @@ def test_regime_onsets_bracket_the_sweep():
     assert r["q_crit_in_plane"] < r["q_in_plane"] < 9.11
     assert r["q_crit_out_of_plane"] < r["q_3d"] < 11.43
     assert 0 < r["amplitude_out_of_plane"] < 1e-3 and 0 < r["amplitude_in_plane"] < 1e-3
+
+
+def test_in_plane_threshold_from_the_numpy_twin():
+    """The number 8.9000904456 itself, from a second discretisation: the plain-NumPy twin
+    of the maps (tests/naive.py: FFTs on a 256-point grid, lstsq tension) differentiated
+    by Richardson central differences, about the vertical circle (θ0 = 90°, q = g0 / 3),
+    in-plane block (x and z components).  The leading non-neutral eigenvalue is tracked
+    at three q around the threshold and its quadratic interpolant's root is q_c."""
+    import naive
+
+    n = 8
+    x = shapes.inclined_circle(n, math.pi / 2)
+    k = 2 * n + 1
+    in_plane = np.r_[0:k, 2 * k:3 * k]
+
+    def leading(q):
+        jac = naive.jacobian(x, 3.0 * q, 10.0)[np.ix_(in_plane, in_plane)]
+        values = np.linalg.eigvals(jac)
+        values = values[np.abs(values) > 1e-5]  # the neutral modes: translations, shift
+        return values[np.argmax(values.real)].real
+
+    qs = np.array([8.8, 8.85, 8.95])
+    rates = np.array([leading(q) for q in qs])
+    assert rates[0] < rates[1] < 0 < rates[2]
+    roots = np.roots(np.polyfit(qs, rates, 2))
+    q_c = roots[np.argmin(np.abs(roots - 8.9))].real
+    assert abs(q_c - Q_IN) < 1e-5, q_c

@@ -37,8 +37,9 @@ def test_velocity_and_tension_match_numpy_reference(n, rng):
         g0, w = rng.uniform(0, 300), rng.uniform(0, 100)
         tension, u = naive.tension_and_velocity(x, g0, w)
         u_fast, tension_fast = api.evaluate_maps(x, g0, w)
-        np.testing.assert_allclose(tension_fast, tension, atol=1e-10 * (1 + np.abs(tension).max()))
-        np.testing.assert_allclose(u_fast, u, atol=1e-10 * (1 + np.abs(u).max()))
+        # measured: 2.6e-13 (tension) and 5.2e-14 (velocity), relative to 1 + max
+        np.testing.assert_allclose(tension_fast, tension, atol=3e-12 * (1 + np.abs(tension).max()))
+        np.testing.assert_allclose(u_fast, u, atol=1e-12 * (1 + np.abs(u).max()))
 
 
 @pytest.mark.parametrize("n", [3, 8])
