@@ -23,7 +23,7 @@ _jitcache.configure()  # before any kernel is decorated: see loopsim/_jitcache.p
 
 from .api import SUMMARY_FIELDS, SimulationResult, evaluate_maps, simulate  # noqa: E402
 from .diagnostics import stability_parameter  # noqa: E402
-from .io import read_results, read_snapshots  # noqa: E402
+from .io import coefficients, read_results, read_snapshots  # noqa: E402
 
 __all__ = ["simulate", "SimulationResult", "evaluate_maps", "stability_parameter",
-           "SUMMARY_FIELDS", "read_results", "read_snapshots", "__version__"]
+           "SUMMARY_FIELDS", "read_results", "read_snapshots", "coefficients", "__version__"]

@@ -33,7 +33,7 @@ import pandas as pd
 import pyarrow as pa
 
 from . import (
-    api, diagnostics, integrators, io, models, outcomes, refinement, shapes, spectral,
+    api, columns, diagnostics, integrators, io, models, outcomes, refinement, shapes, spectral,
     validation,
 )
 from . import _jitcache
@@ -45,33 +45,8 @@ from .config import (
 )
 from .outcomes import REGIMES, Thresholds, classify  # noqa: F401 - re-exported
 
-# ---- the table (schema: io.RESULT_SCHEMA) ----------------------------------
-FIELD_NOTES = {
-    "wall_s": "wall time of the case's task (a task of several cases, or a batch kernel "
-              "call on several threads: its wall time x threads, shared in proportion to "
-              "nfev)",
-    "x_final": "terminal shape coefficients, row-major (3, 2n+1): " + io.COEFFICIENT_LAYOUT,
-    "regime": "stable | in-plane | 3d | failed (see thresholds)",
-    "stop_reason": "t_end | steady (terminal state reached early) | the failure",
-    "length_error_max": "largest |relative length error| along the trajectory (transient)",
-    "resolved": "length_error_max <= thresholds.resolved_length_error and tail_max <= "
-                "thresholds.resolved_tail: n_used resolves the case (False: raise n or use "
-                "--n auto; its terminal outcome is not converged)",
-    "n": "the truncation order the case started at (with --n auto: the ladder's first)",
-    "n_used": "the truncation order the case ended at (with --n auto: the highest reached)",
-    "tail_max": "largest spectral tail (RMS relative amplitude of the top two modes) "
-                "along the run at n_used (with --n auto, lower orders were left when their "
-                "tail passed tail_tol)",
-    "method": "the integrator that ran the case (--method auto chooses per case)",
-    "determined": "a twin run from the same start with every tolerance 10x stricter ends "
-                  "in the same regime within thresholds.determined_tilt_deg and "
-                  "thresholds.determined_aspect (False: the terminal tilt is a sample of an "
-                  "ill-conditioned transient; null: no twin ran)",
-    "theta_uncertainty_deg": "|theta_final_deg - the twin's|: the terminal tilt's error "
-                             "estimate at the tolerances used (deg)",
-    "aspect_uncertainty": "|aspect_ratio - the twin's|",
-    "twin_nfev": "right-hand-side evaluations of the twin run (0: none ran)",
-}
+# ---- the table (schema: io.RESULT_SCHEMA; every column described in loopsim.columns) ----
+FIELD_NOTES = {name: text for name, (_, text) in columns.RESULT_COLUMNS.items()}
 
 
 # ---- configuration -------------------------------------------------------
@@ -377,7 +352,8 @@ def _traced_case(config, case_id):
     for name in ("x", "multiplier"):  # orders differ between cases: variable-length lists
         table = table.set_column(table.schema.get_field_index(name), name,
                                  table.column(name).cast(pa.list_(pa.float64())))
-    return row, table.add_column(0, "case_id", pa.array([case_id] * table.num_rows, pa.int64()))
+    table = table.add_column(0, "case_id", pa.array([case_id] * table.num_rows, pa.int64()))
+    return row, io.described(table, columns.TRAJECTORY_COLUMNS)
 
 
 def run_chunk(config, chunk, threads):

@@ -22,7 +22,7 @@ import pandas as pd
 import pyarrow as pa
 import pyarrow.parquet as pq
 
-from . import diagnostics
+from . import columns, diagnostics
 from ._version import __version__
 
 COEFFICIENT_LAYOUT = (
@@ -53,17 +53,23 @@ _SUMMARY_TYPES = {
     "regime": pa.string(), "resolved": pa.bool_(), "determined": pa.bool_(), "twin_nfev": _INT,
     **{d.name: pa.from_numpy_dtype(np.dtype(d.dtype)) for d in diagnostics.REGISTRY},
 }
-#: The declared schema of every sweep chunk (and of :func:`read_results`).
+#: The declared schema of every sweep chunk (and of :func:`read_results`); each field
+#: carries its unit and description (``loopsim.columns``) in its metadata.
 RESULT_SCHEMA = pa.schema(
-    [pa.field("case_id", _INT)]
-    + [pa.field(name, _SUMMARY_TYPES.get(name, _FLOAT)) for name in SUMMARY_FIELDS]
-    + [
-        pa.field("stop_reason", pa.string()),
-        pa.field("aspect_ratio_initial", _FLOAT),
-        pa.field("length_error_max", _FLOAT),
-        pa.field("x_final", pa.list_(_FLOAT)),
-    ]
+    [pa.field(name, kind, metadata=columns.field_metadata(name)) for name, kind in
+     [("case_id", _INT)]
+     + [(name, _SUMMARY_TYPES.get(name, _FLOAT)) for name in SUMMARY_FIELDS]
+     + [("stop_reason", pa.string()), ("aspect_ratio_initial", _FLOAT),
+        ("length_error_max", _FLOAT), ("x_final", pa.list_(_FLOAT))]]
 )
+
+
+def coefficients(row):
+    """The (3, 2n + 1) coefficient array of a results row's ``x_final`` (a row of
+    :func:`read_results`, a dict, or the list itself): x, y, z, each [a0, a1..an,
+    b1..bn] (``COEFFICIENT_LAYOUT``)."""
+    values = row if isinstance(row, (list, tuple, np.ndarray)) else row["x_final"]
+    return np.asarray(values, dtype=float).reshape(3, -1)
 
 
 def provenance(**extra):
@@ -302,15 +308,17 @@ def _hash_array(digest, array):
 
 
 def content_hash(table, metadata):
-    """SHA-256 (hex) of a table's column names and values and of its schema metadata
+    """SHA-256 (hex) of a table's column names, field metadata and values and of its schema metadata
     ``metadata`` (a dict, without :data:`CONTENT_KEY` and pyarrow's own ``ARROW:`` keys):
     written into every file loopsim writes, checked by :func:`read_table_checked`."""
     digest = hashlib.sha256()
     for key in sorted(metadata):
         if key != CONTENT_KEY and not key.startswith("ARROW:"):
             digest.update(f"{key}\0{metadata[key]}\0".encode())
-    for name, column in zip(table.column_names, table.columns):
-        digest.update(f"\0column {name}\0".encode())
+    for field, column in zip(table.schema, table.columns):
+        digest.update(f"\0column {field.name}\0".encode())
+        for key, value in sorted((field.metadata or {}).items()):  # units, descriptions
+            digest.update(b"\0field " + key + b"\0" + value)
         _hash_array(digest, column.combine_chunks())
     return digest.hexdigest()
 
@@ -370,23 +378,31 @@ def quarantine(directory, path, reason):
     return True
 
 
+def described(table, declarations):
+    """``table`` with each field's unit and description (``loopsim.columns``) in its
+    metadata; the schema's own metadata is kept."""
+    schema = pa.schema([field.with_metadata(columns.field_metadata(field.name, declarations))
+                        for field in table.schema], metadata=table.schema.metadata)
+    return table.cast(schema)
+
+
 def trajectory_table(result, command_line=None):
     """One row per snapshot: time, shape coefficients, multiplier and diagnostics."""
     k = result.x.shape[-1]
     rows = [diagnostics.evaluate(diagnostics.State(x, u, m, result.inputs["g0"]), trajectory=True)
             for x, u, m in zip(result.x, result.u, result.multiplier)]
-    columns = {"t": pa.array(result.t, pa.float64())}
+    data = {"t": pa.array(result.t, pa.float64())}
     for d in diagnostics.REGISTRY:
         if d.trajectory:
-            columns[d.trajectory] = pa.array([r[d.trajectory] for r in rows],
-                                             pa.from_numpy_dtype(np.dtype(d.dtype)))
-    columns.update({
+            data[d.trajectory] = pa.array([r[d.trajectory] for r in rows],
+                                          pa.from_numpy_dtype(np.dtype(d.dtype)))
+    data.update({
         "x": pa.FixedSizeListArray.from_arrays(
             pa.array(result.x.reshape(-1), pa.float64()), 3 * k),
         "multiplier": pa.FixedSizeListArray.from_arrays(
             pa.array(result.multiplier.reshape(-1), pa.float64()), k),
     })
-    table = pa.table(columns)
+    table = described(pa.table(data), columns.TRAJECTORY_COLUMNS)
     meta = provenance(summary=result.summary(), command_line=command_line or [])
     return table.replace_schema_metadata(meta)
 
@@ -534,6 +550,8 @@ def read_results(out):
     meta = read_metadata(paths[0])
     meta.update(sweep_config=stored["config"], thresholds=stored["config"].get("thresholds"),
                 command_line=stored.get("command_line", []),
-                field_notes=stored.get("field_notes", {}), reruns=stored.get("reruns", []))
+                field_notes=stored.get("field_notes", {}), reruns=stored.get("reruns", []),
+                columns={name: dict(unit=unit, description=text)
+                         for name, (unit, text) in columns.RESULT_COLUMNS.items()})
     frame.attrs["loopsim"] = meta
     return frame

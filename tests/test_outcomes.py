@@ -96,3 +96,33 @@ def test_without_a_twin_determined_is_empty(tmp_path):
                  "--quiet", "--out", str(tmp_path / "s")]) == 0
     frame = loopsim.read_results(str(tmp_path / "s"))
     assert frame["determined"].isna().all() and frame["theta_uncertainty_deg"].isna().all()
+
+
+def test_every_written_column_has_a_unit_and_a_description(tmp_path):
+    """Sweep chunks and run files: each Parquet field carries 'unit' and 'description'
+    metadata from the one declaration (loopsim.columns); read_results puts them in
+    attrs; coefficients() gives x_final as (3, 2 n_used + 1)."""
+    import pyarrow.parquet as pq
+
+    from loopsim import columns, io
+
+    out = tmp_path / "s"
+    assert main(["sweep", "--g0", "30", "--theta0", "45", "--t-end", "0.5", "--quiet",
+                 "--snapshots-for", "0", "--snapshots", "3", "--out", str(out)]) == 0
+    run = tmp_path / "run.parquet"
+    assert main(["run", "--g0", "30", "--theta0", "45", "--t-end", "0.5", "--out",
+                 str(run)]) == 0
+    files = list(out.glob("chunk-*.parquet")) + list((out / "_snapshots").glob("*.parquet"))
+    assert len(files) == 2
+    for path in files + [run]:
+        for field in pq.read_schema(path):
+            meta = field.metadata or {}
+            assert meta.get(b"unit") and meta.get(b"description"), (path.name, field.name)
+    assert set(pq.read_schema(files[0]).names) == set(columns.RESULT_COLUMNS)
+    frame = loopsim.read_results(str(out))
+    documented = frame.attrs["loopsim"]["columns"]
+    assert set(documented) == set(frame.columns)
+    assert documented["theta_final_deg"]["unit"] == "deg"
+    x = loopsim.coefficients(frame.iloc[0])
+    assert x.shape == (3, 2 * int(frame["n_used"].iloc[0]) + 1)
+    np.testing.assert_array_equal(x.ravel(), frame["x_final"].iloc[0])
