@@ -16,14 +16,27 @@ from . import _signals
 
 _signals.install_early()  # the loopsim program: Ctrl-C while loading is one line, exit 130
 
-from . import _jitcache  # noqa: E402
 from ._version import __version__  # noqa: E402
 
-_jitcache.configure()  # before any kernel is decorated: see loopsim/_jitcache.py
+#: The public names and the modules that define them, loaded on first use (PEP 562), so
+#: that ``import loopsim.cli`` (``loopsim --help``) loads neither NumPy nor Numba.
+_EXPORTS = {
+    "simulate": "api", "SimulationResult": "api", "evaluate_maps": "api",
+    "SUMMARY_FIELDS": "api", "stability_parameter": "diagnostics",
+    "coefficients": "io", "read_results": "io", "read_snapshots": "io", "sweep": "ensemble",
+}
+__all__ = list(_EXPORTS) + ["__version__"]
 
-from .api import SUMMARY_FIELDS, SimulationResult, evaluate_maps, simulate  # noqa: E402
-from .diagnostics import stability_parameter  # noqa: E402
-from .io import coefficients, read_results, read_snapshots  # noqa: E402
 
-__all__ = ["simulate", "SimulationResult", "evaluate_maps", "stability_parameter",
-           "SUMMARY_FIELDS", "read_results", "read_snapshots", "coefficients", "__version__"]
+def __getattr__(name):
+    if name in _EXPORTS:
+        import importlib
+
+        value = getattr(importlib.import_module(f".{_EXPORTS[name]}", __name__), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_EXPORTS))

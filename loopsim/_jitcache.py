@@ -8,9 +8,9 @@ after a hash of every module a kernel can reach: the modules that define
 kernels (a Numba decorator or ``numba.extending``), and, read with
 ``ast``, everything they import from the package, transitively (a kernel can
 only see globals of modules its own module imports).  Any change there starts
-a fresh cache; an edit to the command line or the figures does not.  This
-module must be imported before any ``@njit(cache=True)`` decorator runs
-(``loopsim/__init__.py`` does so first). A user-set NUMBA_CACHE_DIR is
+a fresh cache; an edit to the command line or the figures does not.  :func:`configure`
+must run before any ``@njit(cache=True)`` decorator: ``config.JIT``, which every kernel
+module imports first, runs it. A user-set NUMBA_CACHE_DIR is
 respected as the parent directory.
 """
 import ast
@@ -103,9 +103,13 @@ def cache_dir():
 
 
 def configure():
-    """Point Numba's cache at :func:`cache_dir` (before kernels are decorated)."""
+    """Point Numba's cache at :func:`cache_dir` (before kernels are decorated) and start
+    the compile clock; once per process (``config.JIT`` calls it on first use)."""
+    if COMPILE_CLOCK.registered:
+        return
     numba.config.CACHE_DIR = cache_dir()
     numba.core.event.register("numba:compile", COMPILE_CLOCK)
+    COMPILE_CLOCK.registered = True
 
 
 # ---- compilation made visible and kept apart from the work ----------------------------
@@ -121,6 +125,7 @@ class CompileClock(numba.core.event.Listener):
     def __init__(self):
         self.seconds = 0.0
         self.announced = False
+        self.registered = False
         self._depth = 0
         self._started = 0.0
 

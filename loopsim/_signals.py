@@ -24,10 +24,27 @@ def is_program(argv=None, orig_argv=None):
     return any(a == "-m" and b == "loopsim" for a, b in zip(orig_argv, orig_argv[1:]))
 
 
+def end_children():
+    """Kill what the program started and has not ended (Dask workers, multiprocessing's
+    resource tracker), so that it leaves no orphan and no orphan's warning behind."""
+    try:
+        import psutil  # installed with dask.distributed
+    except ImportError:
+        return
+    children = psutil.Process().children(recursive=True)
+    for child in children:
+        try:
+            child.kill()
+        except psutil.Error:
+            pass
+    psutil.wait_procs(children, timeout=1.0)
+
+
 def _exit_at_once(signum, frame):
     name = signal.Signals(signum).name
     os.write(2, f"loopsim: interrupted by {name}: stopped (files already written are "
                 "complete; a sweep resumes when re-run)\n".encode())
+    end_children()
     os._exit(128 + signum)
 
 

@@ -14,13 +14,15 @@ import sys
 import warnings
 
 from ._version import __version__
-from .validation import ENVIRONMENT_ERRNOS
 from .config import (
+    ENVIRONMENT_ERRNOS,
     DEFAULT_ATOL, DEFAULT_AUTO_CHUNK_SIZE, DEFAULT_CHUNK_SIZE, DEFAULT_N, DEFAULT_N_MAX,
     DEFAULT_PERTURBATION, DEFAULT_RTOL, DEFAULT_SEED, DEFAULT_T_END, DEFAULT_TAIL_TOL, DEFAULT_W,
 )
 
-from .integrators import METHODS  # noqa: E402 - the names only; no kernel is compiled here
+#: The integrators' names (``loopsim.integrators.METHODS``, tested equal): named here so
+#: that the command line loads no kernel, nor Numba, before it has work to do.
+METHODS = ("radau5", "rkf45")
 
 EXIT_FAILED_RUN = 1
 EXIT_USAGE = 2
@@ -34,7 +36,8 @@ class _HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
 
     def _get_help_string(self, action):
         text = action.help or ""
-        if "default" in text or action.default in (None, False, argparse.SUPPRESS):
+        if ("default" in text or action.default is None or action.default is False
+                or action.default == "" or action.default is argparse.SUPPRESS):
             return text
         return super()._get_help_string(action)
 
@@ -65,7 +68,7 @@ def _add_integration_options(parser):
     parser.add_argument("--w", type=_real, default=DEFAULT_W, help="length-penalty rate")
     parser.add_argument("--perturbation", type=_real, default=DEFAULT_PERTURBATION, metavar="EPS",
                         help="RMS size of the seeded initial perturbation (0: exact circle; "
-                        f"default {DEFAULT_PERTURBATION:g}, or 0 with --initial)")
+                        f"default: {DEFAULT_PERTURBATION:g}, or 0 with --initial)")
     parser.add_argument("--method", default=None, choices=sorted(METHODS) + ["auto"],
                         help="time integrator: rkf45 (explicit, the paper's), radau5 "
                         "(implicit: stiff stable and in-plane loops, any n >= 8) or auto "
@@ -77,11 +80,11 @@ def _add_integration_options(parser):
                         "then empty)")
     parser.add_argument("--n-max", type=int, default=None,
                         help=f"with --n auto: the highest truncation order a case may reach "
-                        f"(default {DEFAULT_N_MAX})")
+                        f"(default: {DEFAULT_N_MAX})")
     parser.add_argument("--tail-tol", type=_real, default=None,
                         help="with --n auto: restart a case at the next order when its "
                         "spectral tail (the top two modes' share of the deformation) passes "
-                        f"this (default {DEFAULT_TAIL_TOL:g})")
+                        f"this (default: {DEFAULT_TAIL_TOL:g})")
 
 
 def _order(text):
@@ -122,7 +125,7 @@ def _build_parser():
                      help="initial tilt of the loop's plane to the horizontal, in [0, 90] degrees "
                      "(not with --initial: the tilt is measured)")
     run.add_argument("--n", type=_order, default=None,
-                     help=f"Fourier truncation order (1..128; default {DEFAULT_N}, or the stored "
+                     help=f"Fourier truncation order (1..128; default: {DEFAULT_N}, or the stored "
                      "order of --initial results), or auto: start there and raise n during "
                      "the run whenever the spectral tail passes --tail-tol")
     run.add_argument("--initial", metavar="FILE|DIR",
@@ -134,7 +137,9 @@ def _build_parser():
     run.set_defaults(perturbation=None)
     run.add_argument("--seed", type=int, default=DEFAULT_SEED, help="perturbation seed (>= 0)")
     run.add_argument("--snapshots", type=int, default=2, metavar="K",
-                     help="number of equally spaced snapshots stored, ends included")
+                     help="states stored of the trajectory: K equally spaced times, both "
+                     "ends included (as sweep --snapshots; here the start and the end by "
+                     "default)")
     run.add_argument("--out", metavar="FILE.parquet",
                      help="write the snapshots (and the summary as metadata) to Parquet")
     run.add_argument("--json", action="store_true", help="print the summary as one JSON object")
@@ -169,14 +174,17 @@ def _build_parser():
     sweep.add_argument("--snapshots-for", metavar="CASE_IDS", default="",
                        help="case ids (v1,v2,...) whose trajectories are stored as snapshots")
     sweep.add_argument("--snapshots", type=int, default=101, metavar="K",
-                       help="snapshots per selected trajectory")
+                       help="states stored of each --snapshots-for trajectory: K equally "
+                       "spaced times, both ends included (as run --snapshots)")
     sweep.add_argument("--threads", type=int, default=None, help="threads (default: all cores)")
     sweep.add_argument("--chunk-size", type=int, default=None,
                        help="cases per chunk file (and per Dask task; default "
                        f"{DEFAULT_CHUNK_SIZE}, or {DEFAULT_AUTO_CHUNK_SIZE} with --n auto, "
                        "whose cases take minutes: a SIGKILL loses the unwritten chunks); may "
                        "change on resume")
-    sweep.add_argument("--out", metavar="DIR", help="sweep directory (required)")
+    sweep.add_argument("--out", metavar="DIR",
+                       help="sweep directory, made if absent (required, except with "
+                       "--rerun-failed)")
     sweep.add_argument("--figure", metavar="PNG", help="also draw the phase diagram")
     sweep.add_argument("--quiet", action="store_true", help="no progress line, only a summary")
     sweep.add_argument("--progress-every", type=_real, default=30.0, metavar="SECONDS",
@@ -188,7 +196,8 @@ def _build_parser():
     where.add_argument("--dask", action="store_true",
                        help="start a Dask LocalCluster here and send chunks to it")
     where.add_argument("--workers", type=int, default=None,
-                       help="with --dask: worker processes (default: cores / --threads)")
+                       help="with --dask: worker processes, at most the cores (default: "
+                       "cores / --threads)")
     where.add_argument("--shard", metavar="I/N",
                        help="only chunks k with k %% N == I (0 <= I < N), for job arrays: "
                        "N jobs with the same command and I = the array index fill DIR together")
@@ -208,11 +217,11 @@ def _build_parser():
     stability.add_argument("--json", action="store_true", help="print one JSON object")
     full = stability.add_argument_group("full linearisation (default)")
     full.add_argument("--n", type=int, default=None,
-                      help="truncation order of the full linearisation (>= 3; default 16)")
+                      help="truncation order of the full linearisation (>= 3; default: 16)")
     full.add_argument("--theta0", type=_real, default=None, metavar="DEG",
-                      help="tilt of the circle in (0, 90] (default 90; the rates depend on q only)")
+                      help="tilt of the circle in (0, 90] (default: 90; the rates depend on q only)")
     full.add_argument("--w", type=_real, default=None,
-                      help=f"length-penalty rate (default {DEFAULT_W:g})")
+                      help=f"length-penalty rate (default: {DEFAULT_W:g})")
     full.add_argument("--q-scan", metavar="START:STOP:NUM|v1,v2,...",
                       help="also the largest growth rate of each sector, the paper's and the "
                       "corrected operator at these q")
@@ -220,7 +229,7 @@ def _build_parser():
                       help="also the spectrum at (G, --theta0): the --top largest eigenvalues "
                       "with sector labels")
     full.add_argument("--top", type=int, default=None,
-                      help="eigenvalues listed with --g0 (default 12)")
+                      help="eigenvalues listed with --g0 (default: 12)")
     full.add_argument("--onset", type=_real, nargs=3, metavar=("EPS", "T_END", "DETECT"),
                       help="also the q where a mode of size EPS reaches DETECT at T_END, per sector")
     full.add_argument("--figure", metavar="PNG",
@@ -229,7 +238,7 @@ def _build_parser():
     paper_group.add_argument("--paper", action="store_true",
                              help="the table of the paper's operator for n = 1..--n-max instead")
     paper_group.add_argument("--n-max", type=int, default=None,
-                             help="largest truncation order of the --paper table (default 60)")
+                             help="largest truncation order of the --paper table (default: 60)")
 
     branch = commands.add_parser(
         "branch", help="steady in-plane shapes from the circle's bifurcation, and their stability",
@@ -404,8 +413,12 @@ def _interrupted(signum, detail):
     if _is_program():
         sys.stdout.flush()
         sys.stderr.flush()
+        from ._signals import end_children
+
+        end_children()
         os._exit(status)
     return status
+
 
 
 RERUN_OPTIONS = ("method", "rtol", "atol")  # what --rerun-failed takes from the command line
@@ -478,9 +491,9 @@ def _check_rerun_options(args):
 
 def _is_program():
     """Whether this process is the ``loopsim`` command (not a caller of :func:`main`)."""
-    program = os.path.abspath(sys.argv[0]) if sys.argv and sys.argv[0] else ""
-    return (os.path.basename(program) == "loopsim"
-            or program.endswith(os.path.join("loopsim", "__main__.py")))
+    from ._signals import is_program
+
+    return is_program()
 
 
 def _cmd_sweep(args):

@@ -16,8 +16,30 @@ Conventions used throughout loopsim (stated once, tested in ``tests/``):
   N = T + |x''|², not the Lagrange multiplier T (see ``diagnostics``).
 """
 
+import errno
+
 # No fastmath: results must be bit-reproducible across thread counts.
-JIT = dict(cache=True, nogil=True, error_model="numpy")
+_JIT = dict(cache=True, nogil=True, error_model="numpy")
+
+
+def __getattr__(name):
+    """``JIT``, the options of every kernel, handed out only once Numba's cache points at
+    loopsim's (``_jitcache.configure``): every kernel module imports it before its first
+    decorator, so the cache is set up exactly when the first kernel is defined, and the
+    command line, which defines none, loads neither Numba nor NumPy (``--help`` is fast)."""
+    if name == "JIT":
+        from . import _jitcache
+
+        _jitcache.configure()
+        globals()["JIT"] = _JIT
+        return _JIT
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+#: OSError numbers that are the machine's fault, not the input's: the command line exits
+#: 3 on them (a full disk, a read-only filesystem, an I/O error, no memory or files left).
+ENVIRONMENT_ERRNOS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EIO,
+                                errno.ENOMEM, errno.EMFILE, errno.ENFILE})
 
 #: Default penalty rate of the length-creation term (see README "Choice of w").
 DEFAULT_W = 10.0

@@ -39,9 +39,9 @@ from . import (
 from . import _jitcache
 from ._blas import one_blas_thread
 from .config import (
-    DEFAULT_ATOL, DEFAULT_CHUNK_SIZE, DEFAULT_LENGTH_TOL, DEFAULT_MAX_STEPS, DEFAULT_N_MAX,
-    DEFAULT_PERTURBATION, DEFAULT_RTOL, DEFAULT_STEADY_INTERVAL, DEFAULT_STEADY_TOL,
-    DEFAULT_T_END, DEFAULT_TAIL_TOL, DEFAULT_W,
+    DEFAULT_ATOL, DEFAULT_AUTO_CHUNK_SIZE, DEFAULT_CHUNK_SIZE, DEFAULT_LENGTH_TOL,
+    DEFAULT_MAX_STEPS, DEFAULT_N, DEFAULT_N_MAX, DEFAULT_PERTURBATION, DEFAULT_RTOL,
+    DEFAULT_STEADY_INTERVAL, DEFAULT_STEADY_TOL, DEFAULT_T_END, DEFAULT_TAIL_TOL, DEFAULT_W,
 )
 from .outcomes import REGIMES, Thresholds, classify  # noqa: F401 - re-exported
 
@@ -940,6 +940,10 @@ def run_sweep(config, out, threads=None, quiet=False, command_line=None, *, sche
     finally:
         if client is not None:
             grace = 1 if stop.is_set() else None  # on a signal: no waiting for tasks
+            if grace is not None:  # connections cut short are expected now, not errors
+                import logging
+
+                logging.getLogger("distributed").setLevel(logging.CRITICAL)
             client.close(**({} if grace is None else dict(timeout=grace)))
             if cluster is not None:
                 _close_cluster(cluster, grace)
@@ -947,6 +951,39 @@ def run_sweep(config, out, threads=None, quiet=False, command_line=None, *, sche
     if stop.is_set():
         raise SweepInterrupted(stop.signum, out, progress.done, progress.total)
     return io.read_results(out)
+
+
+def sweep(g0, theta0_deg, out, *, n=6, seeds=1, method=None, quiet=True, threads=None,
+          scheduler=None, local_cluster=False, workers=None, **options):
+    """The Python form of ``loopsim sweep``: every (g0, θ0, seed) of the grid into the
+    sweep directory ``out`` (made, or resumed), returned as the results DataFrame
+    (:func:`io.read_results`).
+
+    ``g0`` and ``theta0_deg``: values (numbers or sequences); ``n``: an order, a
+    sequence of orders, or "auto"; ``seeds``: seeds 0..seeds-1 per point; ``method``:
+    as in ``simulate`` (default rkf45 at a fixed n, auto with ``n="auto"``).  Every
+    other keyword is a :class:`SweepConfig` field under its own name (``t_end``,
+    ``rtol``, ``atol``, ``w``, ``early_stop``, ``twin``, ``n_max``, ``tail_tol``,
+    ``chunk_size``, ...) or ``perturbation``.  Backends as :func:`run_sweep`.  The
+    directory is the one the command line writes: either may resume the other.
+    """
+    auto = isinstance(n, str)
+    if auto and n != "auto":
+        raise ValueError(f"n must be an order, a sequence of orders or 'auto', got {n!r}")
+    perturbation = options.pop("perturbation", DEFAULT_PERTURBATION)
+    unknown = set(options) - {f.name for f in dataclasses.fields(SweepConfig)} - {"cases"}
+    if unknown or "cases" in options:
+        raise ValueError(f"unknown sweep option(s) {sorted(unknown or {'cases'})}")
+    axes = [np.atleast_1d(np.asarray(v, dtype=float)).tolist() for v in (g0, theta0_deg)]
+    orders = [DEFAULT_N] if auto else [int(v) for v in np.atleast_1d(n)]
+    seeds = validation.check_integer("seeds", seeds, 1)
+    cases = grid_cases(axes[0], axes[1], orders, seeds, perturbation)
+    options.setdefault("chunk_size", DEFAULT_AUTO_CHUNK_SIZE if auto else DEFAULT_CHUNK_SIZE)
+    config = SweepConfig(cases=cases, method=method or ("auto" if auto else "rkf45"),
+                         n_auto=auto, **options)
+    return run_sweep(config, os.fspath(out), threads=threads, quiet=quiet,
+                     command_line=["loopsim.sweep(...)"], scheduler=scheduler,
+                     local_cluster=local_cluster, workers=workers)
 
 
 # ---- rerunning the failed cases -------------------------------------------------------------

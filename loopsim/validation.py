@@ -1,5 +1,4 @@
 """Input checks shared by every entry point: one-line ``ValueError``s naming the value."""
-import errno
 import math
 import numbers
 import os
@@ -134,9 +133,7 @@ def check_input_file(name, path, max_bytes):
     return path
 
 
-#: OSError numbers that are the machine's fault, not the input's (the CLI exits 3 on them).
-ENVIRONMENT_ERRNOS = {errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EIO, errno.ENOMEM,
-                      errno.EMFILE, errno.ENFILE}
+from .config import ENVIRONMENT_ERRNOS  # noqa: E402 - re-exported
 
 
 def _probe_writable(name, path, directory):

@@ -529,3 +529,34 @@ def test_soak_200_random_kills_lose_and_duplicate_nothing(tmp_path):
     columns = [c for c in expected.columns if c != "wall_s"]
     pd.testing.assert_frame_equal(resumed[columns], expected[columns], check_exact=True)
     assert not list(killed.glob(".tmp-*"))
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
+def test_ctrl_c_with_dask_is_one_line_and_leaves_no_process(tmp_path):
+    """SIGINT while a local Dask cluster works: exit 130, no traceback (no
+    CommClosedError from the shutdown), and none of the program's processes alive 1 s
+    after it ended."""
+    import psutil
+
+    out = tmp_path / "s"
+    process = subprocess.Popen(
+        [sys.executable, "-m", "loopsim", "sweep", "--g0", "100:250:8", "--theta0", "30,60",
+         "--chunk-size", "1", "--dask", "--workers", "2", "--out", str(out)],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 300  # the workers may compile first
+    parent = psutil.Process(process.pid)
+    while not list(out.glob("chunk-*.parquet")):  # the workers are at work
+        assert process.poll() is None and time.monotonic() < deadline, process.communicate()
+        time.sleep(0.1)
+    children = parent.children(recursive=True)
+    assert len(children) >= 2
+    process.send_signal(signal.SIGINT)
+    _, stderr = process.communicate(timeout=60)
+    assert process.returncode == 130, stderr
+    lines = [line for line in stderr.splitlines()  # less the notice and progress lines
+             if not line.startswith(("loopsim: compiling", "cases "))]
+    assert "Traceback" not in stderr and "Error" not in stderr, stderr
+    assert len(lines) == 1 and lines[0].startswith("loopsim: interrupted by SIGINT"), stderr
+    time.sleep(1.0)
+    alive = [c.pid for c in children if c.is_running() and c.status() != psutil.STATUS_ZOMBIE]
+    assert alive == [], alive

@@ -126,3 +126,21 @@ def test_every_written_column_has_a_unit_and_a_description(tmp_path):
     x = loopsim.coefficients(frame.iloc[0])
     assert x.shape == (3, 2 * int(frame["n_used"].iloc[0]) + 1)
     np.testing.assert_array_equal(x.ravel(), frame["x_final"].iloc[0])
+
+
+def test_python_sweep_writes_the_directory_the_command_line_writes(tmp_path):
+    """loopsim.sweep(...) mirrors `loopsim sweep`: the same rows, bit for bit, and either
+    resumes the other's directory; bad options are one-line errors."""
+    frame = loopsim.sweep([10.0, 40.0], 30.0, tmp_path / "py", t_end=0.5, twin=False)
+    assert main(["sweep", "--g0", "10,40", "--theta0", "30", "--t-end", "0.5", "--no-twin",
+                 "--quiet", "--out", str(tmp_path / "cli")]) == 0
+    cli = loopsim.read_results(str(tmp_path / "cli"))
+    keep = [c for c in frame.columns if c != "wall_s"]
+    assert len(frame) == 2 and list(frame["case_id"]) == [0, 1]
+    assert frame[keep].equals(cli[keep])
+    again = loopsim.sweep([10.0, 40.0], 30.0, tmp_path / "cli", t_end=0.5, twin=False)
+    assert again[keep].equals(cli[keep])  # resumed: nothing to do, the same table
+    with pytest.raises(ValueError, match="colour"):
+        loopsim.sweep(10.0, 30.0, tmp_path / "bad", colour="red")
+    with pytest.raises(ValueError, match="n must be"):
+        loopsim.sweep(10.0, 30.0, tmp_path / "bad", n="automatic")

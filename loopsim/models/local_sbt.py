@@ -310,16 +310,9 @@ def relative_length_error(x, ops, ws):
 
 
 @numba.njit(**JIT)
-def spectral_tail(x):
-    """Share of the loop's deformation carried by its top modes k ≥ max(2, n − 1), x (3, 2n+1):
-
-        sqrt(Σ_{k ≥ max(2, n-1)} E_k / (Σ_{k ≥ 2} E_k + φ² Σ_{k ≥ 1} E_k)),
-        E_k = ½ Σ_xyz (a_k² + b_k²),  φ = ``config.DEFORMATION_FLOOR``
-
-    (the same as ``diagnostics.spectral_tail``; 0 for a point).  Modes k ≥ 2 are what
-    deforms a circle; relative to them, the tail measures what the truncation does to
-    the deformation that a transient amplifies, not to the loop's size.
-    """
+def energy_sums(x):
+    """(Σ_{k ≥ 1} E_k, Σ_{k ≥ 2} E_k, Σ_{k ≥ max(2, n-1)} E_k) of x (3, 2n+1), with
+    E_k = ½ Σ_xyz (a_k² + b_k²) (the ½ cancels in every ratio: left out)."""
     n = (x.shape[1] - 1) // 2
     first = max(2, n - 1)
     total = 0.0
@@ -334,6 +327,21 @@ def spectral_tail(x):
             deformation += energy
         if k >= first:
             top += energy
+    return total, deformation, top
+
+
+@numba.njit(**JIT)
+def spectral_tail(x):
+    """Share of the loop's deformation carried by its top modes k ≥ max(2, n − 1), x (3, 2n+1):
+
+        sqrt(Σ_{k ≥ max(2, n-1)} E_k / (Σ_{k ≥ 2} E_k + φ² Σ_{k ≥ 1} E_k)),
+        E_k = ½ Σ_xyz (a_k² + b_k²),  φ = ``config.DEFORMATION_FLOOR``
+
+    (the same as ``diagnostics.spectral_tail``; 0 for a point).  Modes k ≥ 2 are what
+    deforms a circle; relative to them, the tail measures what the truncation does to
+    the deformation that a transient amplifies, not to the loop's size.
+    """
+    total, deformation, top = energy_sums(x)
     scale = deformation + DEFORMATION_FLOOR ** 2 * total
     return np.sqrt(top / scale) if scale > 0.0 else 0.0
 
@@ -342,17 +350,7 @@ def spectral_tail(x):
 def top_mode_share(x):
     """RMS amplitude of the top modes k ≥ max(2, n − 1) of x relative to the loop's,
     sqrt(Σ_{k ≥ max(2, n-1)} E_k / Σ_{k ≥ 1} E_k): the absolute size of the tail."""
-    n = (x.shape[1] - 1) // 2
-    first = max(2, n - 1)
-    total = 0.0
-    top = 0.0
-    for k in range(1, n + 1):
-        energy = 0.0
-        for c in range(3):
-            energy += x[c, k] ** 2 + x[c, n + k] ** 2
-        total += energy
-        if k >= first:
-            top += energy
+    total, _, top = energy_sums(x)
     return np.sqrt(top / total) if total > 0.0 else 0.0
 
 
