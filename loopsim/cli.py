@@ -240,6 +240,20 @@ def _build_parser():
     paper_group.add_argument("--n-max", type=int, default=None,
                              help="largest truncation order of the --paper table (default: 60)")
 
+    summary = commands.add_parser(
+        "summary", help="one row per cell of a sweep: regime probabilities, tilt and aspect "
+        "ratio medians, with 95% intervals",
+        description="Summarise a sweep over its seeds: per cell (g0, theta0 and every other "
+        "swept input), the number of seeds, resolved and determined rows, each regime's "
+        "probability with its Wilson interval, the median and quartiles of the terminal "
+        "tilt and aspect ratio with bootstrap intervals of the medians, and the cost "
+        "(loopsim/summary.py).",
+        formatter_class=_HelpFormatter,
+    )
+    summary.add_argument("sweep_dir", metavar="SWEEP_DIR", help="a sweep directory")
+    summary.add_argument("--out", metavar="FILE.parquet", help="also write the table to Parquet")
+    summary.add_argument("--seed", type=int, default=0, help="seed of the bootstrap (>= 0)")
+
     branch = commands.add_parser(
         "branch", help="steady in-plane shapes from the circle's bifurcation, and their stability",
         description="Relative equilibria (shapes that translate without changing) of the "
@@ -722,6 +736,30 @@ def _cmd_figures(args):
     return 0
 
 
+def _cmd_summary(args):
+    import pandas as pd
+    import pyarrow as pa
+
+    from . import io, summary, validation
+
+    validation.check_integer("--seed", args.seed, 0)
+    if args.out is not None:
+        validation.check_output_file("--out", args.out)
+    table = summary.summarize(io.read_results(args.sweep_dir), seed=args.seed)
+    shown = [c for c in table.columns if c in summary.CELL_INPUTS] + [
+        "seeds", "determined", "p_stable", "p_in_plane", "p_3d", "p_3d_low", "p_3d_high",
+        "tilt_median", "tilt_median_low", "tilt_median_high"]
+    with pd.option_context("display.width", 160, "display.max_columns", 40):
+        print(table[shown].to_string(index=False, float_format=lambda v: f"{v:.4g}"))
+    if args.out is not None:
+        meta = io.provenance(summary_of=os.path.abspath(args.sweep_dir),
+                             **table.attrs["loopsim_summary"])
+        io.write_table_atomically(pa.Table.from_pandas(table, preserve_index=False)
+                                  .replace_schema_metadata(meta), args.out)
+        print(f"summary: {args.out}")
+    return 0
+
+
 def _use_agg():
     """Figures from the command line are files: the non-interactive Agg backend."""
     import matplotlib
@@ -743,7 +781,7 @@ def main(argv=None):
     parser = _build_parser()
     args = parser.parse_args(argv)
     handlers = {"run": _cmd_run, "sweep": _cmd_sweep, "stability": _cmd_stability,
-                "branch": _cmd_branch, "figures": _cmd_figures}
+                "branch": _cmd_branch, "figures": _cmd_figures, "summary": _cmd_summary}
     try:
         with _one_line_warnings():
             return handlers[args.command](args)

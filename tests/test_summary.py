@@ -1,0 +1,76 @@
+"""Outcomes as distributions (loopsim.summary): the Wilson interval and the bootstrap
+against closed forms and known cases, cells and their counts, the command."""
+import numpy as np
+import pandas as pd
+import pytest
+
+import loopsim
+from loopsim import summary
+from loopsim.cli import main
+
+
+def test_wilson_interval_closed_forms():
+    z = summary.Z95
+    assert summary.wilson_interval(0, 10) == pytest.approx((0.0, z * z / (10 + z * z)))
+    assert summary.wilson_interval(10, 10) == pytest.approx((10 / (10 + z * z), 1.0))
+    low, high = summary.wilson_interval(5, 10)
+    assert low + high == pytest.approx(1.0) and high - low == pytest.approx(
+        2 * z * np.sqrt(0.25 / 10 + z * z / 400) / (1 + z * z / 10))
+    # a textbook value: 8 of 20 gives (0.2188, 0.6134) to four places
+    assert summary.wilson_interval(8, 20) == pytest.approx((0.2188, 0.6134), abs=1e-4)
+    assert all(np.isnan(summary.wilson_interval(0, 0)))
+
+
+def test_bootstrap_interval_is_seeded_and_covers_the_median():
+    assert summary.bootstrap_interval(np.full(9, 3.5)) == (3.5, 3.5)
+    rng = np.random.default_rng(1)
+    sample = rng.normal(10.0, 2.0, 200)
+    first = summary.bootstrap_interval(sample, seed=7)
+    assert first == summary.bootstrap_interval(sample, seed=7)  # reproducible
+    assert first != summary.bootstrap_interval(sample, seed=8)
+    # the median's standard error is about 1.2533 sigma / sqrt(N) = 0.177: the 95 %
+    # interval spans about 4 of them
+    assert first[0] < np.median(sample) < first[1]
+    assert 0.4 < first[1] - first[0] < 1.1
+    covered = sum(lo < 10.0 < hi for lo, hi in (
+        summary.bootstrap_interval(rng.normal(10.0, 2.0, 50), seed=k, resamples=500)
+        for k in range(100)))
+    assert 85 <= covered <= 100
+
+
+def test_summarize_groups_seeds_into_cells():
+    rows = []
+    for g0 in (30.0, 150.0):
+        for seed in range(8):
+            regime = "stable" if g0 < 100 else ("3d" if seed % 4 else "in-plane")
+            rows.append(dict(g0=g0, theta0_deg=60.0, n=6, seed=seed, rtol=1e-6, regime=regime,
+                             resolved=True, determined=seed != 3,
+                             theta_final_deg=60.0 if g0 < 100 else 20.0 + seed,
+                             aspect_ratio=1.0 + seed / 100, nfev=100, twin_nfev=150,
+                             wall_s=0.5))
+    table = summary.summarize(pd.DataFrame(rows))
+    assert list(table["g0"]) == [30.0, 150.0] and "n" not in table and "seed" not in table
+    stable, hot = table.iloc[0], table.iloc[1]
+    assert stable["seeds"] == 8 and stable["p_stable"] == 1.0 and stable["determined"] == 7
+    assert stable["p_stable_low"] == pytest.approx(8 / (8 + summary.Z95 ** 2))
+    assert hot["p_3d"] == 0.75 and hot["p_in_plane"] == 0.25 and hot["p_failed"] == 0.0
+    assert hot["tilt_median"] == 23.5 and hot["tilt_q25"] == 21.75
+    assert hot["tilt_median_low"] <= 23.5 <= hot["tilt_median_high"]
+    assert hot["nfev"] == 800 and hot["wall_s"] == 4.0
+    with pytest.raises(ValueError, match="no column"):
+        summary.summarize(pd.DataFrame(rows), by=["colour"])
+
+
+def test_summary_command_on_a_sweep_with_seeds(tmp_path, capsys):
+    out = tmp_path / "s"
+    assert main(["sweep", "--g0", "10,40", "--theta0", "30", "--seeds", "3", "--t-end", "0.5",
+                 "--no-twin", "--quiet", "--out", str(out)]) == 0
+    capsys.readouterr()
+    path = tmp_path / "cells" / "summary.parquet"
+    assert main(["summary", str(out), "--out", str(path)]) == 0
+    printed = capsys.readouterr().out
+    assert "p_stable" in printed and f"summary: {path}" in printed
+    table = pd.read_parquet(path)
+    assert list(table["g0"]) == [10.0, 40.0] and list(table["seeds"]) == [3, 3]
+    again = loopsim.summarize(loopsim.read_results(str(out)))
+    pd.testing.assert_frame_equal(table, again)
