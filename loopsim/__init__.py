@@ -24,7 +24,7 @@ _EXPORTS = {
     "simulate": "api", "SimulationResult": "api", "evaluate_maps": "api",
     "SUMMARY_FIELDS": "api", "stability_parameter": "diagnostics",
     "coefficients": "io", "read_results": "io", "read_snapshots": "io", "sweep": "ensemble",
-    "summarize": "summary",
+    "summarize": "summary", "compare": "summary",
 }
 __all__ = list(_EXPORTS) + ["__version__"]
 

@@ -254,6 +254,21 @@ def _build_parser():
     summary.add_argument("--out", metavar="FILE.parquet", help="also write the table to Parquet")
     summary.add_argument("--seed", type=int, default=0, help="seed of the bootstrap (>= 0)")
 
+    compare = commands.add_parser(
+        "compare", help="do two sweeps of the same cells differ in distribution?",
+        description="Per cell of two sweeps (say n = 24 and n = 32, or rtol 1e-6 and 1e-8, "
+        "each with several seeds): Kolmogorov-Smirnov tests of the terminal tilt and "
+        "aspect ratio, the tilt's Wasserstein distance with a bootstrap interval, a "
+        "chi-square test of the regime counts, and a verdict (loopsim/summary.py).",
+        formatter_class=_HelpFormatter,
+    )
+    compare.add_argument("sweep_a", metavar="SWEEP_A", help="a sweep directory")
+    compare.add_argument("sweep_b", metavar="SWEEP_B", help="another, of the same cells")
+    compare.add_argument("--alpha", type=_real, default=0.05,
+                         help="significance level of the verdict (Bonferroni over 3 tests)")
+    compare.add_argument("--out", metavar="FILE.parquet", help="also write the table to Parquet")
+    compare.add_argument("--seed", type=int, default=0, help="seed of the bootstrap (>= 0)")
+
     branch = commands.add_parser(
         "branch", help="steady in-plane shapes from the circle's bifurcation, and their stability",
         description="Relative equilibria (shapes that translate without changing) of the "
@@ -737,9 +752,6 @@ def _cmd_figures(args):
 
 
 def _cmd_summary(args):
-    import pandas as pd
-    import pyarrow as pa
-
     from . import io, summary, validation
 
     validation.check_integer("--seed", args.seed, 0)
@@ -749,15 +761,42 @@ def _cmd_summary(args):
     shown = [c for c in table.columns if c in summary.CELL_INPUTS] + [
         "seeds", "determined", "p_stable", "p_in_plane", "p_3d", "p_3d_low", "p_3d_high",
         "tilt_median", "tilt_median_low", "tilt_median_high"]
-    with pd.option_context("display.width", 160, "display.max_columns", 40):
-        print(table[shown].to_string(index=False, float_format=lambda v: f"{v:.4g}"))
-    if args.out is not None:
-        meta = io.provenance(summary_of=os.path.abspath(args.sweep_dir),
-                             **table.attrs["loopsim_summary"])
-        io.write_table_atomically(pa.Table.from_pandas(table, preserve_index=False)
-                                  .replace_schema_metadata(meta), args.out)
-        print(f"summary: {args.out}")
+    _print_and_write(table, args.out, dict(table.attrs["loopsim_summary"],
+                                           summary_of=os.path.abspath(args.sweep_dir)), shown)
     return 0
+
+
+def _cmd_compare(args):
+    from . import io, summary, validation
+
+    validation.check_integer("--seed", args.seed, 0)
+    validation.check_real("--alpha", args.alpha, low=0.0, high=1.0, low_open=True)
+    if args.out is not None:
+        validation.check_output_file("--out", args.out)
+    table = summary.compare(io.read_results(args.sweep_a), io.read_results(args.sweep_b),
+                            alpha=args.alpha, seed=args.seed)
+    _print_and_write(table, args.out, dict(table.attrs["loopsim_compare"],
+                                           compared=[args.sweep_a, args.sweep_b]))
+    counts = table["verdict"].value_counts().to_dict()
+    print(", ".join(f"{v} cell(s) {k}" for k, v in sorted(counts.items())))
+    return 0
+
+
+def _print_and_write(table, out, meta, shown=None):
+    """Print ``table`` (its ``shown`` columns) and write it to ``out`` (Parquet, atomic,
+    with loopsim's provenance and ``meta`` in its metadata) when given."""
+    import pandas as pd
+    import pyarrow as pa
+
+    from . import io
+
+    with pd.option_context("display.width", 160, "display.max_columns", 40):
+        print(table[shown or list(table.columns)].to_string(
+            index=False, float_format=lambda v: f"{v:.4g}"))
+    if out is not None:
+        io.write_table_atomically(pa.Table.from_pandas(table, preserve_index=False)
+                                  .replace_schema_metadata(io.provenance(**meta)), out)
+        print(f"table: {out}")
 
 
 def _use_agg():
@@ -781,7 +820,8 @@ def main(argv=None):
     parser = _build_parser()
     args = parser.parse_args(argv)
     handlers = {"run": _cmd_run, "sweep": _cmd_sweep, "stability": _cmd_stability,
-                "branch": _cmd_branch, "figures": _cmd_figures, "summary": _cmd_summary}
+                "branch": _cmd_branch, "figures": _cmd_figures, "summary": _cmd_summary,
+                "compare": _cmd_compare}
     try:
         with _one_line_warnings():
             return handlers[args.command](args)

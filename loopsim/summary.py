@@ -101,3 +101,75 @@ def summarize(frame, by=None, seed=0):
                                           bootstrap_resamples=BOOTSTRAP_RESAMPLES,
                                           interval="95 % (Wilson; percentile bootstrap)")
     return table
+
+
+# ---- convergence in distribution: two sweeps of the same cells ---------------------------
+#: The verdicts of :func:`compare`.
+SAME, DIFFERENT = "indistinguishable at this sample size", "different"
+
+
+def _paired_cells(a, b, by):
+    if by is None:
+        common = [c for c in CELL_INPUTS if c in a and c in b]
+        by = [c for c in common if c in ("g0", "theta0_deg")
+              or (set(a[c].unique()) == set(b[c].unique()) and a[c].nunique() > 1)]
+    missing = [c for c in by if c not in a or c not in b]
+    if missing:
+        raise ValueError(f"no column(s) {missing} in both tables to pair the cells by")
+    groups_b = dict(iter(b.groupby(by, sort=True, dropna=False)))
+    pairs = [(key, rows, groups_b[key]) for key, rows in a.groupby(by, sort=True, dropna=False)
+             if key in groups_b]
+    if not pairs:
+        raise ValueError(f"the two tables share no cell (by {by})")
+    return by, pairs
+
+
+def wasserstein_interval(x, y, resamples=BOOTSTRAP_RESAMPLES, seed=0, level=0.95):
+    """(distance, low, high): the 1-Wasserstein distance between the samples x and y with
+    a percentile-bootstrap interval (each sample resampled on its own, seeded)."""
+    from scipy.stats import wasserstein_distance
+
+    x, y = np.asarray(x, float), np.asarray(y, float)
+    x, y = x[np.isfinite(x)], y[np.isfinite(y)]
+    if not (x.size and y.size):
+        return float("nan"), float("nan"), float("nan")
+    rng = np.random.default_rng(seed)
+    draws = [wasserstein_distance(x[rng.integers(0, x.size, x.size)],
+                                  y[rng.integers(0, y.size, y.size)]) for _ in range(resamples)]
+    tail = 100 * (1 - level) / 2
+    low, high = np.percentile(draws, [tail, 100 - tail])
+    return float(wasserstein_distance(x, y)), float(low), float(high)
+
+
+def compare(a, b, by=None, alpha=0.05, seed=0, resamples=500):
+    """Per cell of two results tables (the same cells at, say, n = 24 and n = 32, or two
+    tolerances): two-sample Kolmogorov-Smirnov tests of the terminal tilt and aspect
+    ratio, the tilt's Wasserstein distance with a bootstrap interval, a chi-square test
+    of the regime counts, and a verdict: ``DIFFERENT`` when any of the three p-values is
+    below alpha / 3 (Bonferroni), else ``SAME``.  ``by``: the columns pairing the cells
+    (default g0, theta0_deg and the inputs both tables sweep alike)."""
+    from scipy.stats import chi2_contingency, ks_2samp
+
+    by, pairs = _paired_cells(a, b, by)
+    rows = []
+    for key, rows_a, rows_b in pairs:
+        out = dict(zip(by, key if isinstance(key, tuple) else (key,)),
+                   seeds_a=len(rows_a), seeds_b=len(rows_b))
+        for column, short in (("theta_final_deg", "tilt"), ("aspect_ratio", "aspect")):
+            x, y = rows_a[column].to_numpy(float), rows_b[column].to_numpy(float)
+            x, y = x[np.isfinite(x)], y[np.isfinite(y)]
+            out[f"{short}_ks_p"] = float(ks_2samp(x, y).pvalue) if x.size and y.size else np.nan
+        out["tilt_wasserstein"], out["tilt_wasserstein_low"], out["tilt_wasserstein_high"] = (
+            wasserstein_interval(rows_a["theta_final_deg"], rows_b["theta_final_deg"],
+                                 resamples, seed))
+        counts = pd.crosstab(pd.concat([rows_a["regime"], rows_b["regime"]], ignore_index=True),
+                             np.repeat([0, 1], [len(rows_a), len(rows_b)]))
+        out["regime_p"] = (1.0 if counts.shape[0] < 2
+                           else float(chi2_contingency(counts.to_numpy())[1]))
+        p_values = [out["tilt_ks_p"], out["aspect_ks_p"], out["regime_p"]]
+        out["verdict"] = DIFFERENT if np.nanmin(p_values) < alpha / 3 else SAME
+        rows.append(out)
+    table = pd.DataFrame(rows)
+    table.attrs["loopsim_compare"] = dict(cells_by=by, alpha=alpha, bootstrap_seed=seed,
+                                          bootstrap_resamples=resamples)
+    return table

@@ -69,8 +69,50 @@ def test_summary_command_on_a_sweep_with_seeds(tmp_path, capsys):
     path = tmp_path / "cells" / "summary.parquet"
     assert main(["summary", str(out), "--out", str(path)]) == 0
     printed = capsys.readouterr().out
-    assert "p_stable" in printed and f"summary: {path}" in printed
+    assert "p_stable" in printed and f"table: {path}" in printed
     table = pd.read_parquet(path)
     assert list(table["g0"]) == [10.0, 40.0] and list(table["seeds"]) == [3, 3]
     again = loopsim.summarize(loopsim.read_results(str(out)))
     pd.testing.assert_frame_equal(table, again)
+
+
+def _seeds_table(tilts, regimes=None, g0=150.0):
+    return pd.DataFrame(dict(g0=g0, theta0_deg=60.0, seed=np.arange(len(tilts)),
+                             theta_final_deg=tilts, aspect_ratio=2.0 + np.asarray(tilts) / 100,
+                             regime=regimes if regimes is not None else ["3d"] * len(tilts)))
+
+
+def test_compare_verdicts_on_one_distribution_and_on_shifted_ones():
+    rng = np.random.default_rng(3)
+    same_a, same_b = rng.normal(20, 5, 40), rng.normal(20, 5, 40)
+    shifted = rng.normal(30, 5, 40)
+    same = summary.compare(_seeds_table(same_a), _seeds_table(same_b))
+    assert same["verdict"].tolist() == [summary.SAME]
+    assert same["tilt_ks_p"].iloc[0] > 0.05 and same["seeds_a"].iloc[0] == 40
+    low, high = same[["tilt_wasserstein_low", "tilt_wasserstein_high"]].iloc[0]
+    assert low <= same["tilt_wasserstein"].iloc[0] <= high
+    different = summary.compare(_seeds_table(same_a), _seeds_table(shifted))
+    assert different["verdict"].tolist() == [summary.DIFFERENT]
+    assert different["tilt_ks_p"].iloc[0] < 1e-4
+    assert 7 < different["tilt_wasserstein"].iloc[0] < 13  # the shift is 10
+    # regimes alone: the same tilts, but half the seeds in plane in one table
+    regimes = summary.compare(_seeds_table(same_a),
+                              _seeds_table(same_a, ["3d", "in-plane"] * 20))
+    assert regimes["regime_p"].iloc[0] < 1e-4 and regimes["verdict"].iloc[0] == summary.DIFFERENT
+    with pytest.raises(ValueError, match="share no cell"):
+        summary.compare(_seeds_table(same_a), _seeds_table(same_b, g0=10.0))
+
+
+def test_compare_command_on_two_sweeps(tmp_path, capsys):
+    """rtol 1e-6 against 1e-7 on stable cells: the same distributions."""
+    for name, rtol in (("a", "1e-6"), ("b", "1e-7")):
+        assert main(["sweep", "--g0", "10,40", "--theta0", "30", "--seeds", "4", "--t-end",
+                     "0.5", "--rtol", rtol, "--no-twin", "--quiet", "--out",
+                     str(tmp_path / name)]) == 0
+    capsys.readouterr()
+    assert main(["compare", str(tmp_path / "a"), str(tmp_path / "b"), "--out",
+                 str(tmp_path / "c.parquet")]) == 0
+    printed = capsys.readouterr().out
+    assert "2 cell(s) indistinguishable at this sample size" in printed
+    assert len(pd.read_parquet(tmp_path / "c.parquet")) == 2
+    assert main(["compare", str(tmp_path / "a"), str(tmp_path / "b"), "--alpha", "0"]) == 2
