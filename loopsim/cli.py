@@ -253,6 +253,8 @@ def _build_parser():
     summary.add_argument("sweep_dir", metavar="SWEEP_DIR", help="a sweep directory")
     summary.add_argument("--out", metavar="FILE.parquet", help="also write the table to Parquet")
     summary.add_argument("--seed", type=int, default=0, help="seed of the bootstrap (>= 0)")
+    summary.add_argument("--figure", metavar="PNG",
+                         help="also draw P(3D) per cell and the terminal tilt over seeds")
 
     compare = commands.add_parser(
         "compare", help="do two sweeps of the same cells differ in distribution?",
@@ -755,14 +757,27 @@ def _cmd_summary(args):
     from . import io, summary, validation
 
     validation.check_integer("--seed", args.seed, 0)
-    if args.out is not None:
-        validation.check_output_file("--out", args.out)
-    table = summary.summarize(io.read_results(args.sweep_dir), seed=args.seed)
+    for name, path in (("--out", args.out), ("--figure", args.figure)):
+        if path is not None:
+            validation.check_output_file(name, path)
+    frame = io.read_results(args.sweep_dir)
+    table = summary.summarize(frame, seed=args.seed)
     shown = [c for c in table.columns if c in summary.CELL_INPUTS] + [
         "seeds", "determined", "p_stable", "p_in_plane", "p_3d", "p_3d_low", "p_3d_high",
         "tilt_median", "tilt_median_low", "tilt_median_high"]
     _print_and_write(table, args.out, dict(table.attrs["loopsim_summary"],
                                            summary_of=os.path.abspath(args.sweep_dir)), shown)
+    if args.figure is not None:
+        _use_agg()
+        import matplotlib.pyplot as plt
+
+        from . import plots
+
+        fig, axes = plt.subplots(1, 2, figsize=(13.5, 4.2), constrained_layout=True)
+        plots.probability_phase_diagram(table, ax=axes[0])
+        plots.tilt_distribution(table, frame, ax=axes[1])
+        plots.save(fig, args.figure, dpi=150)
+        print(f"figure: {args.figure}")
     return 0
 
 

@@ -156,3 +156,64 @@ def trajectory(frame, n, title="", axes=None):
     ax_time.set(xlabel="t", ylabel="tilt θ (deg)")
     ax_ratio.set_ylabel("aspect ratio (variances)", color="C1")
     return ax_shape.figure
+
+
+def probability_phase_diagram(cells, frame=None, ax=None):
+    """The phase diagram read as probabilities: each cell of a summary table
+    (``loopsim.summarize``) at (θ0, g0), coloured by its probability of ending 3D, ringed
+    red where any seed is not determined, labelled with P(in-plane) when it is neither 0
+    nor 1; with the full linearisation's thresholds (``q_c`` at n = 16)."""
+    fig, ax = _axes(ax, (6.8, 4.0))
+    points = ax.scatter(cells["theta0_deg"], cells["g0"], c=cells["p_3d"], cmap="viridis",
+                        vmin=0.0, vmax=1.0, s=60, edgecolors="k", linewidths=0.4, zorder=3)
+    fig.colorbar(points, ax=ax, label="P(3D) over seeds")
+    mixed = cells[cells["determined"] < cells["seeds"]]
+    if len(mixed):
+        ax.scatter(mixed["theta0_deg"], mixed["g0"], s=150, facecolors="none",
+                   edgecolors="#d62728", linewidths=0.9, zorder=4,
+                   label="some seeds not determined")
+    for _, cell in cells[(cells["p_in_plane"] > 0) & (cells["p_in_plane"] < 1)].iterrows():
+        ax.annotate(f"{cell['p_in_plane']:.2f}", (cell["theta0_deg"], cell["g0"]),
+                    textcoords="offset points", xytext=(0, 7), ha="center", fontsize=6)
+    theta = np.linspace(1.0, 90.0, 300)
+    for sector, style in (("in-plane", "--"), ("out-of-plane", ":")):
+        q_sector = circle.critical_q(16, sector)
+        ax.plot(theta, 3 * q_sector / np.sin(np.radians(theta)), "k", ls=style, lw=1.0,
+                label=f"{sector} threshold, q = {q_sector:.3f}")
+    ax.set_xlim(0, 92)
+    ax.set_ylim(0, 1.08 * cells["g0"].max())
+    ax.set_xlabel(r"initial tilt $\theta_0$ (deg)")
+    ax.set_ylabel(r"$g_0$ (gravity / stiffness)")
+    seeds = sorted(set(cells["seeds"]))
+    ax.set_title(f"P(3D) per cell, {'-'.join(str(s) for s in (seeds[0], seeds[-1]))} seeds "
+                 "per cell (numbers: P(in-plane))", fontsize=10)
+    ax.legend(fontsize=7, frameon=False, loc="upper left", bbox_to_anchor=(1.25, 1.0))
+    return fig
+
+
+def tilt_distribution(cells, frame=None, ax=None):
+    """Terminal tilt against q0 as distributions (the distributional form of the paper's
+    Fig. 7): per cell the median with its 95 % bootstrap interval (bars) and quartiles
+    (thin bars), every seed's tilt faint behind (``frame``, the rows), with the
+    out-of-plane threshold."""
+    fig, ax = _axes(ax, (6.0, 4.0))
+    q0 = cells["g0"] * np.sin(np.radians(cells["theta0_deg"])) / 3
+    if frame is not None:
+        ax.scatter(frame["q0"], frame["theta_final_deg"], s=6, color="0.75", zorder=1,
+                   label="each seed")
+    ax.errorbar(q0, cells["tilt_median"],
+                yerr=[cells["tilt_median"] - cells["tilt_q25"],
+                      cells["tilt_q75"] - cells["tilt_median"]],
+                fmt="none", ecolor="0.4", elinewidth=0.7, zorder=2, label="quartiles")
+    ax.errorbar(q0, cells["tilt_median"],
+                yerr=[cells["tilt_median"] - cells["tilt_median_low"],
+                      cells["tilt_median_high"] - cells["tilt_median"]],
+                fmt="o", ms=3.5, color="#3b0f70", elinewidth=1.6, zorder=3,
+                label="median, 95% interval")
+    q_out = circle.critical_q(16, "out-of-plane")
+    ax.axvline(q_out, color="k", ls=":", lw=1.0, label=f"out-of-plane threshold, q = {q_out:.3f}")
+    ax.set_xlabel(r"$q_0 = g_0 \sin\theta_0 / 3$")
+    ax.set_ylabel(r"terminal tilt $\theta$ (deg)")
+    ax.set_title("terminal tilt over seeds", fontsize=10)
+    ax.legend(fontsize=7, frameon=False)
+    return fig

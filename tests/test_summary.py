@@ -116,3 +116,31 @@ def test_compare_command_on_two_sweeps(tmp_path, capsys):
     assert "2 cell(s) indistinguishable at this sample size" in printed
     assert len(pd.read_parquet(tmp_path / "c.parquet")) == 2
     assert main(["compare", str(tmp_path / "a"), str(tmp_path / "b"), "--alpha", "0"]) == 2
+
+
+def test_summary_figures_draw_every_cell():
+    import matplotlib
+    matplotlib.use("Agg")
+    from loopsim import plots
+
+    rows = []
+    for g0 in (30.0, 150.0):
+        for theta in (30.0, 60.0):
+            for seed in range(4):
+                regime = "stable" if g0 < 100 else ("3d" if seed else "in-plane")
+                rows.append(dict(g0=g0, theta0_deg=theta, seed=seed, regime=regime,
+                                 resolved=True, determined=not (g0 > 100 and seed == 2),
+                                 q0=g0 * np.sin(np.radians(theta)) / 3,
+                                 theta_final_deg=theta - (10 + seed if g0 > 100 else 0),
+                                 aspect_ratio=1.5, nfev=1, twin_nfev=1, wall_s=0.1))
+    frame = pd.DataFrame(rows)
+    cells = summary.summarize(frame)
+    fig = plots.probability_phase_diagram(cells)
+    colours = fig.axes[0].collections[0]
+    assert len(colours.get_offsets()) == 4
+    np.testing.assert_allclose(colours.get_array(), cells["p_3d"])
+    rings = [c for c in fig.axes[0].collections if c.get_label() == "some seeds not determined"]
+    assert len(rings) == 1 and len(rings[0].get_offsets()) == 2
+    assert sorted(t.get_text() for t in fig.axes[0].texts) == ["0.25", "0.25"]
+    fig = plots.tilt_distribution(cells, frame)
+    assert len(fig.axes[0].collections[0].get_offsets()) == len(frame)  # every seed, faint
