@@ -302,11 +302,12 @@ def simulate(
     start = time.perf_counter()
     status, t_final, x_final, n_used, counts, worst, x_out = refinement.integrate_case(
         method_object, g0, w, x0, t0, t_end, t_eval, options, ladder, tail_tol)
-    twin_state = twin_end_state(method_object, g0, w, x0, t0, t_end, options, ladder,
-                                tail_tol, theta0_deg) if twin else None
+    twin_state = (twin_end_state(method_object, g0, w, x0, t0, t_end, options, ladder,
+                                 tail_tol, theta0_deg)
+                  if twin and status in integrators.SUCCESS else None)  # a failure: no outcome
     compile_s = _jitcache.compile_seconds() - compiled
     wall = time.perf_counter() - start - compile_s
-    if twin:  # the twin's time is not the run's: split the wall time by RHS evaluations
+    if twin_state is not None:  # the twin's time is not the run's: split by RHS evaluations
         wall *= float(counts[2]) / (counts[2] + twin_state["nfev"])
 
     problem = models.local_sbt.make_problem(n_used, g0, w)

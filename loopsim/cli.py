@@ -242,7 +242,7 @@ def _build_parser():
 
     summary = commands.add_parser(
         "summary", help="one row per cell of a sweep: regime probabilities, tilt and aspect "
-        "ratio medians, with 95% intervals",
+        "ratio medians, with 95%% intervals",
         description="Summarise a sweep over its seeds: per cell (g0, theta0 and every other "
         "swept input), the number of seeds, resolved and determined rows, each regime's "
         "probability with its Wilson interval, the median and quartiles of the terminal "

@@ -98,7 +98,10 @@ NO_TWIN = dict(determined=None, theta_uncertainty_deg=math.nan, aspect_uncertain
 
 def determinacy(run, twin, twin_nfev, thresholds=Thresholds()):
     """Determinacy fields from the run's and its twin's outcomes (dicts with
-    ``regime``, ``theta_final_deg``, ``aspect_ratio``)."""
+    ``regime``, ``theta_final_deg``, ``aspect_ratio``).  A failed run has no outcome to
+    be determined or not: its fields are those of :data:`NO_TWIN` (the twin's cost kept)."""
+    if run["regime"] == "failed":
+        return dict(NO_TWIN, twin_nfev=int(twin_nfev))
     tilt = abs(run["theta_final_deg"] - twin["theta_final_deg"])
     aspect = abs(run["aspect_ratio"] - twin["aspect_ratio"])
     determined = (run["regime"] == twin["regime"] != "failed"
