@@ -184,10 +184,11 @@ def probability_phase_diagram(cells, frame=None, ax=None):
     ax.set_ylim(0, 1.08 * cells["g0"].max())
     ax.set_xlabel(r"initial tilt $\theta_0$ (deg)")
     ax.set_ylabel(r"$g_0$ (gravity / stiffness)")
-    seeds = sorted(set(cells["seeds"]))
-    ax.set_title(f"P(3D) per cell, {'-'.join(str(s) for s in (seeds[0], seeds[-1]))} seeds "
-                 "per cell (numbers: P(in-plane))", fontsize=10)
-    ax.legend(fontsize=7, frameon=False, loc="upper left", bbox_to_anchor=(1.25, 1.0))
+    seeds = sorted(set(int(k) for k in cells["seeds"]))
+    count = str(seeds[0]) if len(seeds) == 1 else f"{seeds[0]}-{seeds[-1]}"
+    ax.set_title(f"P(3D) per cell over {count} seeds (numbers: P(in-plane))", fontsize=10)
+    ax.legend(fontsize=7, frameon=False, loc="upper center", bbox_to_anchor=(0.5, -0.14),
+              ncol=3)
     return fig
 
 
@@ -201,10 +202,12 @@ def tilt_distribution(cells, frame=None, ax=None):
     if frame is not None:
         ax.scatter(frame["q0"], frame["theta_final_deg"], s=6, color="0.75", zorder=1,
                    label="each seed")
-    ax.errorbar(q0, cells["tilt_median"],
+    shift = 0.012 * (q0.max() - q0.min() if len(q0) > 1 else 1.0)  # beside the medians
+    ax.errorbar(q0 + shift, cells["tilt_median"],
                 yerr=[cells["tilt_median"] - cells["tilt_q25"],
                       cells["tilt_q75"] - cells["tilt_median"]],
-                fmt="none", ecolor="0.4", elinewidth=0.7, zorder=2, label="quartiles")
+                fmt="none", ecolor="0.45", elinewidth=0.8, capsize=3, zorder=2,
+                label="quartiles")
     ax.errorbar(q0, cells["tilt_median"],
                 yerr=[cells["tilt_median"] - cells["tilt_median_low"],
                       cells["tilt_median_high"] - cells["tilt_median"]],
@@ -215,5 +218,5 @@ def tilt_distribution(cells, frame=None, ax=None):
     ax.set_xlabel(r"$q_0 = g_0 \sin\theta_0 / 3$")
     ax.set_ylabel(r"terminal tilt $\theta$ (deg)")
     ax.set_title("terminal tilt over seeds", fontsize=10)
-    ax.legend(fontsize=7, frameon=False)
+    ax.legend(fontsize=7, framealpha=0.9, loc="best")
     return fig
