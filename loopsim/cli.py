@@ -170,7 +170,7 @@ def _build_parser():
     _add_integration_options(sweep)
     sweep.add_argument("--no-early-stop", action="store_true",
                        help="always integrate to --t-end (default: stop once the shape and tilt "
-                       "are steady, see README)")
+                       "are steady, see docs/sweeps.md)")
     sweep.add_argument("--snapshots-for", metavar="CASE_IDS", default="",
                        help="case ids (v1,v2,...) whose trajectories are stored as snapshots")
     sweep.add_argument("--snapshots", type=int, default=101, metavar="K",

@@ -494,13 +494,13 @@ def run_piece(config, piece, threads=None, out=None, fingerprint=None):
 #: ``--n auto`` sweeps: a 3D case's wall time grows like q0**AUTO_COST_EXPONENT.  Fitted
 #: (log-log least squares) to the 24 3D cases among the first 32 of the resolved main-job
 #: grid (radau5, rtol 1e-6, t = 10): exponent 3.95, and 0.058 s × (q0 / 11)^3.95 meets the
-#: cheap cases' median, 0.066 s, at q0 = 11 (README "Automatic truncation").
+#: cheap cases' median, 0.066 s, at q0 = 11 (docs/earlier-n-auto.md).
 AUTO_COST_EXPONENT = 4.0
 
 
 def case_weight(case, n_auto=False):
     """Estimated relative cost of a case, for the ETA.  Fixed n: n², times 3 when q0 > 11
-    (3D loops: 2.7× the RHS evaluations of stable ones in README "Ensemble benchmark"; one
+    (3D loops: 2.7× the RHS evaluations of stable ones in docs/performance.md; one
     RHS costs about n^1.7).  ``n_auto``: n² × (q0 / 11)^4 when q0 > 11 (the resolved 3D
     transient climbs to n = 24–32, and its cost spans 1 s to minutes with q0)."""
     theta = case.get("theta0_deg", math.nan)
@@ -897,7 +897,7 @@ def run_sweep(config, out, threads=None, quiet=False, command_line=None, *, sche
     run on until their kernel returns, then stop).
     ``write`` (Dask): "client" (default: pieces come back and this process writes them;
     no shared filesystem needed) or "worker" (each worker writes its pieces into ``out``,
-    which it must see at the same path); measured equal (README "Dask and job arrays").
+    which it must see at the same path); measured equal (docs/sweeps.md, "Dask and job arrays").
     """
     import numba
 

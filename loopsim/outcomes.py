@@ -17,7 +17,7 @@ differences at or below ``Thresholds.determined_tilt_deg`` and
 ``Thresholds.determined_aspect``.  Where the transient is chaotic the two runs
 part ways and the row says so.  The evidence that the estimate tracks the real
 error (against fixed high-order runs from the same start, and against a
-perturbed start) is in the README, "Determined or not".
+perturbed start) is in docs/auto-and-determinacy.md.
 """
 import dataclasses
 import math

@@ -13,10 +13,9 @@ same start, bit for bit: nothing of a lower order's dynamics is carried into it.
 Why restart rather than go on from the refinement time (which an earlier version
 did): a 3D transient amplifies what a lower order got wrong before its tail passed
 the tolerance.  Going on gave terminal tilts up to 18 degrees off same-start fixed
-runs on hard 3D cases (g0 = 150); a restart cannot.  The cost is the lower orders'
+runs on hard 3D cases (g0 = 150); a restart carries nothing over.  The cost is the lower orders'
 partial runs, which end where their tail passes ``tail_tol``, early in a 3D
-transient (counted in the case's ``nfev`` and ``wall_s``; README "Automatic
-truncation").
+transient (counted in the case's ``nfev`` and ``wall_s``; docs/auto-and-determinacy.md).
 
 Everything here is orchestration of the compiled driver, level by level: a level
 is one call of ``integrators.integrate`` (one case) or ``batch.integrate_cases``
@@ -42,7 +41,7 @@ def auto_method(q0, n, refine):
     """The integrator for a case: RKF45 for a fixed n ≤ 6 run expected to turn 3D (q0
     above the out-of-plane threshold: short explicit steps are cheapest while the
     shape changes fast), Radau IIA otherwise (stiffness grows like n⁴; stable and
-    in-plane loops settle and long implicit steps win).  Evidence: README, "Which
+    in-plane loops settle and long implicit steps win).  Evidence: docs/choosing-n-method-rtol.md, "Which
     integrator"."""
     return "rkf45" if (not refine and n <= 6 and q0 > Q_OUT_OF_PLANE) else "radau5"
 

@@ -68,7 +68,7 @@ def check_tilt(name, value, allow_zero=True):
 # ---- sizes: bounded before any work --------------------------------------------------------
 #: Largest truncation order accepted (--n, --n-max, a case's n, an initial shape's n).  One
 #: right-hand side costs about 0.3 s at n = 128 and 6 s at n = 256 (measured on a loaded
-#: 2-core machine, README "Limits"), and the explicit step shrinks like n^-4: beyond 128 a
+#: 2-core machine, docs/cli.md, "Limits"), and the explicit step shrinks like n^-4: beyond 128 a
 #: single run takes days.
 MAX_N = 128
 #: Most snapshots per run or traced sweep case: each is a step end, and at n = 128 they hold

@@ -1,5 +1,4 @@
-"""Same-start study of ``n="auto"`` and of the determinacy estimate (README, "Automatic
-truncation" and "Determined or not").
+"""Same-start study of ``n="auto"`` and of the determinacy estimate (docs/auto-and-determinacy.md).
 
     python scripts/auto_study.py [--cases G0:DEG[:SEED],...] [--json OUT.jsonl]
 
