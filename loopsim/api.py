@@ -142,7 +142,7 @@ class SimulationResult:
                 f" spectral tail up to {self.tail_max:.2g}, limit "
                 f"{self.thresholds.resolved_tail:g}): the terminal tilt and shape are not "
                 "converged; increase n or use n auto")
-        if self.determined is False:
+        if self.determined is False and self.success:  # a failure says so in its status
             d = self.determinacy
             lines.append(
                 f"outcome not determined: a twin run at {outcomes.TWIN_FACTOR:g}x stricter "
@@ -302,9 +302,13 @@ def simulate(
     start = time.perf_counter()
     status, t_final, x_final, n_used, counts, worst, x_out = refinement.integrate_case(
         method_object, g0, w, x0, t0, t_end, t_eval, options, ladder, tail_tol)
-    twin_state = (twin_end_state(method_object, g0, w, x0, t0, t_end, options, ladder,
-                                 tail_tol, theta0_deg)
-                  if twin and status in integrators.SUCCESS else None)  # a failure: no outcome
+    twin_state = None
+    if twin and status in integrators.SUCCESS:
+        twin_state = twin_end_state(method_object, g0, w, x0, t0, t_end, options, ladder,
+                                    tail_tol, theta0_deg)
+    elif twin:  # a failed run has no outcome to check: no twin is run, and it is not determined
+        twin_state = dict(regime="failed", theta_final_deg=math.nan, aspect_ratio=math.nan,
+                          nfev=0, n_used=int(n_used))
     compile_s = _jitcache.compile_seconds() - compiled
     wall = time.perf_counter() - start - compile_s
     if twin_state is not None:  # the twin's time is not the run's: split by RHS evaluations

@@ -66,7 +66,8 @@ RESULT_COLUMNS = {
                        "resolves the case (False: its outcome is not converged in n)"),
     "determined": (FLAG, "a twin from the same start at 10x stricter tolerances ends in the "
                          "same regime within the determined_* thresholds (False: the terminal "
-                         "tilt is a sample of an ill-conditioned transient; null: no twin)"),
+                         "tilt is a sample of an ill-conditioned transient, or the run "
+                         "failed; null: no twin was asked for)"),
     "theta_uncertainty_deg": (DEG, "|theta_final_deg - the twin's|: the terminal tilt's "
                                    "error estimate at the tolerances used"),
     "aspect_uncertainty": (ONE, "|aspect_ratio - the twin's|"),

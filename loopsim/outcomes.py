@@ -98,10 +98,11 @@ NO_TWIN = dict(determined=None, theta_uncertainty_deg=math.nan, aspect_uncertain
 
 def determinacy(run, twin, twin_nfev, thresholds=Thresholds()):
     """Determinacy fields from the run's and its twin's outcomes (dicts with
-    ``regime``, ``theta_final_deg``, ``aspect_ratio``).  A failed run has no outcome to
-    be determined or not: its fields are those of :data:`NO_TWIN` (the twin's cost kept)."""
+    ``regime``, ``theta_final_deg``, ``aspect_ratio``).  A failed run has no outcome: it
+    is not determined, with no uncertainty to give (``determined`` is empty only where no
+    twin was asked for, so a column never mixes empty and False)."""
     if run["regime"] == "failed":
-        return dict(NO_TWIN, twin_nfev=int(twin_nfev))
+        return dict(NO_TWIN, determined=False, twin_nfev=int(twin_nfev))
     tilt = abs(run["theta_final_deg"] - twin["theta_final_deg"])
     aspect = abs(run["aspect_ratio"] - twin["aspect_ratio"])
     determined = (run["regime"] == twin["regime"] != "failed"

@@ -68,10 +68,12 @@ def test_determinacy_rule():
     failed = outcomes.end_state(30.0, 1.0, np.full((3, 5), np.nan), False)
     assert failed["regime"] == "failed" and math.isnan(failed["theta_final_deg"])
     assert not outcomes.determinacy(run, failed, 1)["determined"]
-    nothing = outcomes.determinacy(failed, run, 7)  # a failed run: nothing to determine
-    assert nothing["determined"] is None and nothing["twin_nfev"] == 7
+    nothing = outcomes.determinacy(failed, run, 7)  # a failed run: no outcome to determine
+    assert nothing["determined"] is False and nothing["twin_nfev"] == 7
+    assert np.isnan(nothing["theta_uncertainty_deg"])
     result = loopsim.simulate(60.0, 30.0, t_span=(0, 1.0), max_steps=20)
-    assert not result.success and result.determined is None and result.twin is None
+    assert not result.success and result.determined is False  # and no twin was run:
+    assert result.summary()["twin_nfev"] == 0
     assert outcomes.twin_tolerances(1e-6, 1e-9, 1e-5) == pytest.approx((1e-7, 1e-10, 1e-6), rel=1e-15)
 
 
