@@ -150,3 +150,14 @@ def test_python_sweep_writes_the_directory_the_command_line_writes(tmp_path):
         loopsim.sweep(10.0, 30.0, tmp_path / "bad", colour="red")
     with pytest.raises(ValueError, match="n must be"):
         loopsim.sweep(10.0, 30.0, tmp_path / "bad", n="automatic")
+
+
+def test_the_docs_column_table_is_the_declaration():
+    """docs/sweeps.md's column table is `python -m loopsim.columns`, not a stale copy."""
+    import os
+
+    from loopsim import columns
+
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    with open(os.path.join(root, "docs", "sweeps.md"), encoding="utf-8") as handle:
+        assert columns.markdown() in handle.read()
