@@ -336,4 +336,5 @@ def simulate(
 
 
 class LoopsimWarning(UserWarning):
-    """A result that needs care: not resolved, or not determined (``SimulationResult.warnings``)."""
+    """A result that needs care: not resolved, or not determined
+    (``SimulationResult.warnings``)."""

@@ -41,7 +41,8 @@ def __getattr__(name):
 ENVIRONMENT_ERRNOS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EIO,
                                 errno.ENOMEM, errno.EMFILE, errno.ENFILE})
 
-#: Default penalty rate of the length-creation term (docs/model.md, "Choice of the length penalty w").
+#: Default penalty rate of the length-creation term (docs/model.md, "Choice of the length
+#: penalty w").
 DEFAULT_W = 10.0
 DEFAULT_N = 6
 DEFAULT_T_END = 10.0

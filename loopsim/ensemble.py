@@ -395,7 +395,8 @@ def run_chunk(config, chunk, threads):
                         tail_tol=twin_tail)
         outputs.append((members, x0, method, result, twins))
     wall = time.perf_counter() - start - (_jitcache.compile_seconds() - compiled)
-    total_rhs = sum(int(result[4][:, 2].sum()) + (0 if twins is None else int(twins[4][:, 2].sum()))
+    total_rhs = sum(int(result[4][:, 2].sum())
+                    + (0 if twins is None else int(twins[4][:, 2].sum()))
                     for *_, result, twins in outputs) or 1
     rows = {}
     for members, x0, method, (x_final, _, t_final, status, counts, worst), twins in outputs:
