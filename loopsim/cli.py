@@ -5,7 +5,6 @@ exit status 2; a run that fails numerically exits 1 after printing its summary; 
 machine refusing to go on (disk full, read-only filesystem, I/O error) exits 3.
 """
 import argparse
-import errno
 import contextlib
 import json
 import math
@@ -27,8 +26,6 @@ METHODS = ("radau5", "rkf45")
 EXIT_FAILED_RUN = 1
 EXIT_USAGE = 2
 EXIT_ENVIRONMENT = 3
-#: OSError numbers that are the machine's fault, not the input's: exit EXIT_ENVIRONMENT.
-ENVIRONMENT_ERRORS = ENVIRONMENT_ERRNOS
 
 
 class _HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
@@ -740,8 +737,6 @@ def _cmd_branch(args):
 
 
 def _cmd_figures(args):
-    import os
-
     _use_agg()
     from . import figures
 
@@ -842,7 +837,7 @@ def main(argv=None):
             return handlers[args.command](args)
     except (ValueError, OSError) as exc:
         print(f"loopsim: error: {exc}", file=sys.stderr)
-        if isinstance(exc, OSError) and exc.errno in ENVIRONMENT_ERRORS:
+        if isinstance(exc, OSError) and exc.errno in ENVIRONMENT_ERRNOS:  # the machine's fault
             return EXIT_ENVIRONMENT
         return EXIT_USAGE
 

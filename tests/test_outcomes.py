@@ -110,7 +110,7 @@ def test_every_written_column_has_a_unit_and_a_description(tmp_path):
     attrs; coefficients() gives x_final as (3, 2 n_used + 1)."""
     import pyarrow.parquet as pq
 
-    from loopsim import columns, io
+    from loopsim import columns
 
     out = tmp_path / "s"
     assert main(["sweep", "--g0", "30", "--theta0", "45", "--t-end", "0.5", "--quiet",
