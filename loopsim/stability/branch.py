@@ -1,41 +1,5 @@
-"""Steady in-plane shapes (relative equilibria), their continuation in q and their stability.
-
-The state is x (3, K), K = 2n + 1, and dx/dt = F(x; g0) is loopsim's spectral
-right-hand side (``models.local_sbt.loop_velocity``, tension solve included).
-
-Frame.  Every in-plane problem is posed at θ0 = 90°: the loop lies in the
-vertical x–z plane, x = X(s) e_x + Z(s) e_z, gravity -g0 e_z lies in the plane
-and q = g0 / 3.  Nothing is lost: for a loop in a plane tilted by θ, only the
-in-plane gravity component g0 sin θ = 3q shapes it (the normal component adds
-the uniform velocity -g0 cos θ e_n and nothing else, because t·e_n = 0), and
-both stability sectors depend on q alone (docs/stability.md §1; checked for
-the branch in the tests by tilting a steady shape).
-
-Steady shapes.  A relative equilibrium translates rigidly, possibly with its
-material points sliding along the curve: x(s, t) = x*(s + c t) + V t, so
-
-    F(x*; 3q) = V + c x*'                                               (1)
-
-(V uniform, c the sliding rate; the arc-length shift s → s + σ is a symmetry
-of the equations).  Unknowns u = [X (K), Z (K), V_x, V_z, c], equations
-H(u; q) = 0 (2K + 3 rows):
-
-    F_x(x) - V_x e_0 - c D X = 0,   F_z(x) - V_z e_0 - c D Z = 0      (2K rows: (1))
-    X_0 = 0,   Z_0 = 0                                               (translations)
-    ⟨x_ref', x - x_ref⟩ = 0                                           (arc-length shift)
-
-with e_0 the mean coefficient, D = ``spectral.derivative_matrix``, ⟨·,·⟩ the
-L² product of the coefficient layout (``circle.l2_weights``) and x_ref the
-previous point of the branch.  The rigid motions left by gravity along -z are
-exactly these: the translations and the shift; an in-plane rotation changes
-the angle to gravity (no phase condition), and the two rotations out of the
-plane leave it (they are neutral out-of-plane modes, below).  ∂H/∂u is built
-from the exact Jacobian ``loop_jacobian``; F is affine in g0 at fixed shape
-(the tension solve is linear in the affine part), so ∂F/∂q = 3 [F(x; 1) -
-F(x; 0)] exactly.  The steady shapes do not depend on the length penalty w:
-with c = 0 and V uniform, (1) makes ε = -w (1 - |x'|²) the least-squares
-residual, orthogonal to the tension's range, so w changes neither T nor F.
-Their length error is what the order-n tension cannot remove (``length_error``).
+"""The branch of steady in-plane shapes: its continuation in q from the circle and its
+stability (the steady equations and their Newton solve: ``stability.steady``).
 
 Continuation.  In the mirror-symmetric subspace X(-s) = -X(s), Z(-s) = Z(s)
 (``mirror_symmetric_index``; invariant under F, and where the runs' terminal
@@ -77,26 +41,26 @@ import math
 import numpy as np
 from scipy.optimize import brentq
 
-from .. import diagnostics, spectral, validation
+from .. import spectral, validation
 from ..config import DEFAULT_W
 from ..models import local_sbt
 from ..shapes import inclined_circle
 from .circle import critical_q, l2_weights
+# The steady equations, re-exported: ``stability.branch`` has always offered them.
+from .steady import (  # noqa: F401
+    NORMAL, PLANE, SteadyShape, mirror_symmetric_index, newton, planar_state, plane_index,
+    solve_steady, steady_jacobian, steady_residual, steady_shape, steady_velocity, tilt_shape,
+    to_plane, velocity_jacobian,
+)
 
 __all__ = [
     "PLANE", "NORMAL", "steady_residual", "steady_jacobian", "SteadyShape", "solve_steady",
+    "planar_state", "tilt_shape", "to_plane", "mirror_symmetric_index",
     "neutral_modes", "stability", "Branch", "continue_branch", "steady_branch",
-    "q_loss_out_of_plane", "planar_state", "tilt_shape", "to_plane", "mirror_symmetric_index",
-    "branch_rows", "branch_summary", "ROW_FIELDS", "upper_half", "out_of_plane_loss",
-    "out_of_plane_loss_near",
+    "q_loss_out_of_plane", "branch_rows", "branch_summary", "ROW_FIELDS", "upper_half",
+    "out_of_plane_loss", "out_of_plane_loss_near",
 ]
 
-#: Components of x in the loop's plane (e_x, e_z) and normal to it (e_y), at θ0 = 90°.
-PLANE = (0, 2)
-NORMAL = 1
-#: Newton: converged when max|H| ≤ NEWTON_TOL · max(1, max|F|); at most NEWTON_MAX_ITER.
-NEWTON_TOL = 1e-12
-NEWTON_MAX_ITER = 12
 #: First corrector's distance from the circle along φ (L² amplitude), and the
 #: pseudo-arclength step limits.
 START_AMPLITUDE = 1e-3
@@ -110,198 +74,6 @@ STRETCH_FRACTION = 0.3
 STABILITY_TOL = 1e-8
 #: Penalty rate used for the spectrum (stretch modes at -2 SPECTRUM_W, out of the way).
 SPECTRUM_W = 1000.0
-
-
-# ---------------------------------------------------------------- the steady equations
-def planar_state(n, x_plane):
-    """x (3, K) from the in-plane coefficients [X, Z] (2, K) (Y = 0)."""
-    x = np.zeros((3, spectral.n_coeffs(n)))
-    x[PLANE[0]], x[PLANE[1]] = x_plane
-    return x
-
-
-def _velocity(x, g0, w, problem):
-    u = np.empty_like(x)
-    local_sbt.loop_velocity(x, g0, w, problem.ops, problem.ws, u)
-    return u
-
-
-def steady_residual(x, velocity, slide, q, w=DEFAULT_W):
-    """R = F(x; 3q) - V e_0 - c D x  (3, K): zero for a relative equilibrium, eq. (1)."""
-    x = np.ascontiguousarray(x, dtype=float)
-    n = spectral.order_of(x.shape[1])
-    problem = local_sbt.make_problem(n, 3.0 * q, w)
-    r = _velocity(x, 3.0 * q, w, problem) - slide * x @ spectral.derivative_matrix(n).T
-    r[:, 0] -= velocity
-    return r
-
-
-def _jacobian(x, g0, w, problem):
-    jac = np.empty((x.size, x.size))
-    local_sbt.loop_jacobian(x, g0, w, problem.ops, problem.ws, jac)
-    return jac
-
-
-def _plane_index(k):
-    """Indices of X and Z in x.ravel() (component-major)."""
-    return np.concatenate([np.arange(c * k, (c + 1) * k) for c in PLANE])
-
-
-def steady_jacobian(x, slide, q, w=DEFAULT_W, x_ref=None):
-    """H(u; q) of the module docstring, ∂H/∂u (2K+3, 2K+3) and ∂H/∂q (2K+3) at a planar x.
-
-    u = [X, Z, V_x, V_z, c]; V is taken as the mean of F (so the mean rows of H
-    vanish and H is the residual of (1) for that V).  Returns (H, dH/du, dH/dq, F).
-    """
-    x = np.ascontiguousarray(x, dtype=float)
-    k = x.shape[1]
-    n = spectral.order_of(k)
-    d = spectral.derivative_matrix(n)
-    x_ref = x if x_ref is None else x_ref
-    wts = np.tile(l2_weights(n), 2)
-    problem = local_sbt.make_problem(n, 3.0 * q, w)
-    f = _velocity(x, 3.0 * q, w, problem)
-    jac = _jacobian(x, 3.0 * q, w, problem)
-    idx = _plane_index(k)
-    jp = jac[np.ix_(idx, idx)]
-    xp = x[list(PLANE)]
-    dxp = xp @ d.T
-    size = 2 * k + 3
-    h = np.zeros(size)
-    dh = np.zeros((size, size))
-    r = f[list(PLANE)] - slide * dxp
-    r[:, 0] = 0.0                         # V = mean of F
-    h[:2 * k] = r.ravel()
-    dh[:2 * k, :2 * k] = jp - slide * np.kron(np.eye(2), d)
-    dh[0, 2 * k] = dh[k, 2 * k + 1] = -1.0
-    dh[:2 * k, 2 * k + 2] = -dxp.ravel()
-    h[2 * k], h[2 * k + 1] = xp[0, 0], xp[1, 0]
-    dh[2 * k, 0] = dh[2 * k + 1, k] = 1.0
-    tangent_ref = (x_ref[list(PLANE)] @ d.T).ravel() * wts
-    h[2 * k + 2] = tangent_ref @ (xp - x_ref[list(PLANE)]).ravel()
-    dh[2 * k + 2, :2 * k] = tangent_ref
-    f1 = _velocity(x, 1.0, w, problem)
-    f0 = _velocity(x, 0.0, w, problem)
-    dq = np.zeros(size)
-    dq[:2 * k] = 3.0 * (f1 - f0)[list(PLANE)].ravel()
-    for c in range(2):
-        dq[c * k] = 0.0                   # the mean rows hold V, which absorbs it
-    return h, dh, dq, f
-
-
-@dataclasses.dataclass
-class SteadyShape:
-    """A relative equilibrium at q: x (3, K) (Y = 0), velocity V (3), sliding rate c,
-    multiplier T (K), and the Newton residual max|F - V - c x'| / max(1, max|F|)."""
-
-    q: float
-    x: np.ndarray
-    velocity: np.ndarray
-    slide: float
-    multiplier: np.ndarray
-    residual: float
-    iterations: int
-    w: float = DEFAULT_W
-
-    @property
-    def n(self):
-        return spectral.order_of(self.x.shape[1])
-
-    @property
-    def aspect_ratio(self):
-        return diagnostics.aspect_ratio(self.x)
-
-    @property
-    def length_error(self):
-        return diagnostics.relative_length_error(self.x)
-
-
-def _residual_norm(x, slide, q, w):
-    f = steady_residual(x, 0.0, slide, q, w)
-    scale = max(1.0, np.abs(f).max())
-    f[:, 0] = 0.0
-    return float(np.abs(f).max() / scale)
-
-
-def _finish(x, slide, q, w, iterations):
-    problem = local_sbt.make_problem(spectral.order_of(x.shape[1]), 3.0 * q, w)
-    f = _velocity(x, 3.0 * q, w, problem)
-    return SteadyShape(q=float(q), x=x, velocity=f[:, 0].copy(), slide=float(slide),
-                       multiplier=problem.ws.tension.copy(),
-                       residual=_residual_norm(x, slide, q, w), iterations=iterations, w=float(w))
-
-
-def mirror_symmetric_index(n):
-    """Unknowns (and rows) of H that stay when x is mirror symmetric about the vertical,
-    X(-s) = -X(s), Z(-s) = Z(s): X's sine and Z's cosine coefficients, V_z (and the
-    rows: (1)'s X-sine and Z-cosine rows, the phase Z_0 = 0).  F maps this subspace
-    into itself (the mirror x → -x, s → -s is a symmetry), V_x = c = 0 on it and the
-    shift and X_0 conditions hold identically."""
-    k = 2 * n + 1
-    return np.concatenate([np.arange(n + 1, k), np.arange(k, k + n + 1), [2 * k + 1]])
-
-
-def _newton(x, slide, q, w, extra=None, x_ref=None, free=None):
-    """Newton on H = 0 (q fixed when extra is None) or on [H; g] = 0 with q unknown,
-    extra = (a_x (2K), a_q, target): the linear condition ⟨a_x, [X, Z]⟩ + a_q q = target.
-    ``free``: the unknowns (= rows) solved for (default all; ``mirror_symmetric_index``).
-
-    Returns (x, slide, q, iterations) or None if it does not converge.
-    """
-    x = x.copy()
-    k = x.shape[1]
-    x_ref = x.copy() if x_ref is None else x_ref
-    free = np.arange(2 * k + 3) if free is None else free
-    for it in range(NEWTON_MAX_ITER + 1):
-        h, dh, dq, f = steady_jacobian(x, slide, q, w, x_ref)
-        scale = max(1.0, np.abs(f).max())
-        g = 0.0
-        if extra is not None:
-            a_x, a_q, target = extra
-            g = a_x @ x[list(PLANE)].ravel() + a_q * q - target
-        if max(np.abs(h).max(), abs(g)) <= NEWTON_TOL * scale:
-            return x, slide, q, it
-        if it == NEWTON_MAX_ITER:
-            break
-        step = np.zeros(2 * k + 3)
-        dq_step = 0.0
-        sub = dh[np.ix_(free, free)]
-        if extra is None:
-            step[free] = np.linalg.solve(sub, -h[free])
-        else:
-            size = free.size
-            big = np.zeros((size + 1, size + 1))
-            big[:size, :size] = sub
-            big[:size, size] = dq[free]
-            ax = np.zeros(2 * k + 3)
-            ax[:2 * k] = a_x
-            big[size, :size] = ax[free]
-            big[size, size] = a_q
-            full = np.linalg.solve(big, -np.concatenate([h[free], [g]]))
-            step[free], dq_step = full[:size], full[size]
-        if not np.all(np.isfinite(step)) or not math.isfinite(dq_step):
-            return None
-        for i, c in enumerate(PLANE):
-            x[c] += step[i * k:(i + 1) * k]
-        slide += step[2 * k + 2]
-        q += dq_step
-    return None
-
-
-def solve_steady(x_guess, q, w=DEFAULT_W, slide=0.0, symmetric=False):
-    """Newton on the steady equations (1) at fixed q from a planar guess x (3, K) (its Y
-    row is dropped, its mean removed), with all phase conditions, or within the
-    mirror-symmetric subspace (``symmetric``; the guess's antisymmetric part is kept
-    as it is).  Raises ValueError if it does not converge."""
-    x = np.ascontiguousarray(x_guess, dtype=float).copy()
-    n = spectral.order_of(x.shape[1])
-    x[NORMAL] = 0.0
-    x[:, 0] = 0.0
-    free = mirror_symmetric_index(n) if symmetric else None
-    out = _newton(x, float(slide), float(q), float(w), free=free)
-    if out is None:
-        raise ValueError(f"Newton on the steady equations did not converge at q = {q}")
-    return _finish(out[0], out[1], q, w, out[3])
 
 
 # ---------------------------------------------------------------- stability
@@ -357,13 +129,13 @@ def stability(shape, w_spectrum=None):
     n = spectral.order_of(k)
     w = max(shape.w, SPECTRUM_W) if w_spectrum is None else float(w_spectrum)
     problem = local_sbt.make_problem(n, 3.0 * shape.q, w)
-    op = _jacobian(x, 3.0 * shape.q, w, problem) \
+    op = velocity_jacobian(x, 3.0 * shape.q, w, problem) \
         - shape.slide * np.kron(np.eye(3), spectral.derivative_matrix(n))
     sq = np.sqrt(np.tile(l2_weights(n), 3))
     op_w = sq[:, None] * op / sq[None, :]            # L in L²-orthonormal coordinates
     n_in, n_out = neutral_modes(x)
     eye = np.eye(3 * k)
-    q_in = _quotient_basis(eye[:, _plane_index(k)], n_in * sq)
+    q_in = _quotient_basis(eye[:, plane_index(k)], n_in * sq)
     q_out = _quotient_basis(eye[:, NORMAL * k:(NORMAL + 1) * k], n_out * sq)
     nw = np.vstack([n_in, n_out]) * sq
     nw /= np.linalg.norm(nw, axis=1)[:, None]
@@ -451,7 +223,7 @@ def continue_branch(n, q_max, w=DEFAULT_W, side=1, q_min=0.0, max_points=400, st
     a_phi = wts * phi.ravel()
 
     def off_circle(h):
-        out = _newton(x_c + planar_state(n, h * phi), 0.0, qc, w,
+        out = newton(x_c + planar_state(n, h * phi), 0.0, qc, w,
                       extra=(a_phi, 0.0, a_phi @ xp_c + h), x_ref=x_c, free=free)
         if out is None:
             raise ValueError(f"no steady shape at amplitude {h} off the circle (n = {n})")
@@ -461,9 +233,9 @@ def continue_branch(n, q_max, w=DEFAULT_W, side=1, q_min=0.0, max_points=400, st
     plus2, minus2 = off_circle(2 * START_AMPLITUDE), off_circle(-2 * START_AMPLITUDE)
     # q(h) = q_c + q1 h + q2 h² + ...: the even part, Richardson-extrapolated to h = 0
     q_bif = (4.0 * (plus[2] + minus[2]) - (plus2[2] + minus2[2])) / 6.0
-    shapes = [_finish(x_c, 0.0, qc, w, 0)]
+    shapes = [steady_shape(x_c, 0.0, qc, w, 0)]
     first = plus if side > 0 else minus
-    shapes.append(_finish(first[0], first[1], first[2], w, first[3]))
+    shapes.append(steady_shape(first[0], first[1], first[2], w, first[3]))
     metric = np.concatenate([wts, [1.0]])
     ys = [np.concatenate([xp_c, [qc]]), np.concatenate([first[0][list(PLANE)].ravel(), [first[2]]])]
     tangent = _branch_tangent(shapes[-1], free, metric, ys[-1] - ys[-2])
@@ -471,11 +243,11 @@ def continue_branch(n, q_max, w=DEFAULT_W, side=1, q_min=0.0, max_points=400, st
     while len(shapes) < max_points and q_min <= shapes[-1].q <= q_max:
         pred = ys[-1] + step * tangent
         a = metric * tangent
-        out = _newton(planar_state(n, pred[:-1].reshape(2, k)), shapes[-1].slide, pred[-1], w,
+        out = newton(planar_state(n, pred[:-1].reshape(2, k)), shapes[-1].slide, pred[-1], w,
                       extra=(a[:-1], a[-1], a @ pred), x_ref=shapes[-1].x, free=free)
         if out is not None:
             y_new = np.concatenate([out[0][list(PLANE)].ravel(), [out[2]]])
-            shape = _finish(out[0], out[1], out[2], w, out[3])
+            shape = steady_shape(out[0], out[1], out[2], w, out[3])
             new_tangent = _branch_tangent(shape, free, metric, tangent)
             # reject a corrector that wandered off (e.g. onto the circle's branch) or a turn
             # too sharp for the step
@@ -613,34 +385,3 @@ def branch_summary(n=12, q_max=25.0, w=DEFAULT_W, q_min=None):
                 q_loss_out_of_plane=q_loss, branch=rows)
 
 
-# ---------------------------------------------------------------- other frames
-def tilt_shape(x, theta0):
-    """A shape of the x–z plane (the θ0 = 90° frame) turned about e_x so that its plane is
-    tilted by θ0 (radians): e_z → [0, cos θ0, sin θ0], e_y → [0, sin θ0, -cos θ0].  The
-    in-plane gravity is then g0 sin θ0: the same q for g0 = 3q / sin θ0."""
-    c, s = math.cos(theta0), math.sin(theta0)
-    return np.array([[1.0, 0.0, 0.0], [0.0, s, c], [0.0, -c, s]]) @ x
-
-
-def to_plane(x):
-    """A nearly planar loop (3, K) in any orientation, as [X, Z] in its plane, with its tilt.
-
-    Plane normal ν: the covariance eigenvector of the smallest eigenvalue; in-plane
-    horizontal axis a = ν × e_z / |ν × e_z|, in-plane upward axis b = a × ν (b_z ≥ 0).
-    Returns (planar x (3, K) with Y = 0 and mean 0, tilt θ in radians, out-of-plane RMS).
-    The rotation about the vertical is a symmetry, so a is any horizontal direction.
-    """
-    _, vectors = diagnostics.principal_axes(x)
-    nu = vectors[:, 0]
-    a = np.cross(nu, [0.0, 0.0, 1.0])
-    a /= np.linalg.norm(a)
-    b = np.cross(a, nu)
-    if b[2] < 0:
-        b, nu = -b, -nu
-    xc = x.copy()
-    xc[:, 0] = 0.0
-    out = np.zeros_like(x)
-    out[PLANE[0]] = a @ xc
-    out[PLANE[1]] = b @ xc
-    theta = math.acos(min(1.0, abs(nu[2])))
-    return out, theta, float(diagnostics.rms_amplitude((nu @ xc)[None]))
