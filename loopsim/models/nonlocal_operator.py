@@ -35,7 +35,7 @@ s grid this is a Nyström rule on grid values, spectrally accurate in M.
 **High modes.**  Λ + K is not positive for short waves: on the ring, mode k has a
 non-positive eigenvalue from k ≈ 0.68 R/a = 0.108/ε (the coupled tangential-normal
 block; the binormal one from k ≈ 1.85 R/a), the known breakdown of SBT at wavelengths
-of a few radii.  A truncation n must stay below it (ε = 1e-2: n ≤ 10; 1e-3: n ≤ 108).
+below about nine radii.  A truncation n must stay below it (ε = 1e-2: n ≤ 10; 1e-3: n ≤ 108).
 
 Shapes must be parametrised by arc length (|x'| = 1: the SBT's s is arc length);
 :func:`arclength_parametrised` makes such coefficients from any smooth loop.
@@ -157,7 +157,7 @@ def kernel_geometry(x, m, arclength_tol=ARCLENGTH_TOL):
     Q_ij ρ_ij with ρ_ij = 2|sin((s_j - s_i)/2)| / |x_i - x_j| (ρ_ii = 1/|x'_i|) and
     Q_ij = q_{(j-i) mod m} + 2 log(4/π) δ_ij (:func:`singular_weights`); and the unit
     vectors e_ij = (x_i - x_j)/|x_i - x_j| (3, m, m), e_ii = x'_i/|x'_i|.  Then
-    K[f](s_i) = Σ_j (Qρ)_ij [f_j + e_ij (e_ij · f_j)].
+    K[f] at s_i is Σ_j (Qρ)_ij [f_j + e_ij (e_ij · f_j)].
     """
     x, n = _shape(x)
     if m < 2 * n + 1:
@@ -299,11 +299,8 @@ def _rigid_order(x_order, n):
     return max(8, 2 * x_order) if n is None else n
 
 
-def rigid_force(x, velocity, angular_velocity=(0.0, 0.0, 0.0), eps=None, n=None,
-                quadrature_points=None, arclength_tol=ARCLENGTH_TOL):
-    """Coefficients (3, 2n+1) of the force density f with u[f] = U + Ω × (x - x̄) (x̄ the
-    mean of x over s), solved on order n (default max(8, 2 n_x)).  eps=None: the local
-    model u = (I + x'x') f; otherwise the nonlocal one."""
+def _rigid_system(x, eps, n, quadrature_points, arclength_tol):
+    """The coefficient matrix of u[f] on order n and the arm x - x̄ (order n)."""
     x, nx = _shape(x)
     n = _rigid_order(nx, n)
     if eps is None:
@@ -312,6 +309,15 @@ def rigid_force(x, velocity, angular_velocity=(0.0, 0.0, 0.0), eps=None, n=None,
         a = nonlocal_matrix(x, eps, n, quadrature_points, arclength_tol)
     arm = spectral.resize(x, n)
     arm[:, 0] = 0.0  # x - x̄
+    return a, arm
+
+
+def rigid_force(x, velocity, angular_velocity=(0.0, 0.0, 0.0), eps=None, n=None,
+                quadrature_points=None, arclength_tol=ARCLENGTH_TOL):
+    """Coefficients (3, 2n+1) of the force density f with u[f] = U + Ω × (x - x̄) (x̄ the
+    mean of x over s), solved on order n (default max(8, 2 n_x)).  eps=None: the local
+    model u = (I + x'x') f; otherwise the nonlocal one."""
+    a, arm = _rigid_system(x, eps, n, quadrature_points, arclength_tol)
     rhs = np.cross(np.asarray(angular_velocity, dtype=float), arm, axis=0)
     rhs[:, 0] += np.asarray(velocity, dtype=float)
     return np.linalg.solve(a, rhs.reshape(-1)).reshape(rhs.shape)
@@ -322,8 +328,7 @@ def force_and_torque(x, f):
     x, nx = _shape(x)
     nf = spectral.order_of(np.shape(f)[-1])
     m = 2 * (nx + nf) + 1  # the products' order is nx + nf: their means are exact here
-    arm = x @ spectral.synthesis_matrix(nx, m).T
-    arm -= x[:, :1]
+    arm = x @ spectral.synthesis_matrix(nx, m).T - x[:, :1]
     fg = np.asarray(f, dtype=float) @ spectral.synthesis_matrix(nf, m).T
     return (2.0 * np.pi * np.mean(fg, axis=1),
             2.0 * np.pi * np.mean(np.cross(arm, fg, axis=0), axis=1))
@@ -333,23 +338,13 @@ def rigid_resistance(x, eps=None, n=None, quadrature_points=None, arclength_tol=
     """6x6 resistance matrix of the loop held rigid: [F; T] = R [U; Ω], columns the unit
     translations then rotations about the centroid (:func:`rigid_force`,
     :func:`force_and_torque`).  eps=None: the local model."""
-    x, nx = _shape(x)
-    n = _rigid_order(nx, n)
-    if eps is None:
-        a = local_matrix(x, n, quadrature_points)
-    else:
-        a = nonlocal_matrix(x, eps, n, quadrature_points, arclength_tol)
-    arm = spectral.resize(x, n)
-    arm[:, 0] = 0.0
-    rhs = np.zeros((6, 3, spectral.n_coeffs(n)))
+    a, arm = _rigid_system(x, eps, n, quadrature_points, arclength_tol)
+    rhs = np.zeros((6,) + arm.shape)
     for j in range(3):
         rhs[j, j, 0] = 1.0
         rhs[3 + j] = np.cross(np.eye(3)[j], arm, axis=0)
     forces = np.linalg.solve(a, rhs.reshape(6, -1).T).T.reshape(rhs.shape)
-    resistance = np.zeros((6, 6))
-    for j in range(6):
-        resistance[:3, j], resistance[3:, j] = force_and_torque(x, forces[j])
-    return resistance
+    return np.stack([np.concatenate(force_and_torque(x, f)) for f in forces], axis=1)
 
 
 def rigid_velocity(x, force, torque=(0.0, 0.0, 0.0), eps=None, n=None, quadrature_points=None,
