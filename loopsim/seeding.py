@@ -34,7 +34,7 @@ class SeedTargets:
     answer is sharp")."""
 
     p_halfwidth: float = 0.15
-    tilt_halfwidth_deg: float = 2.0
+    tilt_halfwidth_deg: float = 2.5
     min_seeds: int = 4
     max_seeds: int = 64
     tilt_tol_deg: float = 0.05
