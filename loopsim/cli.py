@@ -381,7 +381,7 @@ def _cmd_run(args):
 def _run(args):
     import functools
 
-    from . import api, ensemble, io, validation
+    from . import api, io, sweeps, validation
 
     _check_run_sizes(args)
     if args.out is not None:
@@ -401,9 +401,9 @@ def _run(args):
         n_max=args.n_max, tail_tol=args.tail_tol, twin=not args.no_twin)
     for warning in [] if info is None else info["warnings"]:  # the input's, before the run's
         print(f"loopsim: warning: {warning}", file=sys.stderr)
-    stop = ensemble.stop_event()
-    with ensemble.stop_on_signals(stop):  # the integration in a thread, a signal noticed
-        result = ensemble.in_background(stop, simulate)  # within 0.1 s (see _interrupted)
+    stop = sweeps.stop_event()
+    with sweeps.stop_on_signals(stop):  # the integration in a thread, a signal noticed
+        result = sweeps.in_background(stop, simulate)  # within 0.1 s (see _interrupted)
         if result is None:
             return _interrupted(stop.signum, "the run was stopped; nothing written")
         summary = result.summary()
@@ -463,43 +463,43 @@ def _parse_shard(text):
     return index, count
 
 
-def _sweep_config(args, ensemble):
+def _sweep_config(args, sweeps):
     from . import validation
 
     _check_auto_options(args)
     if args.cases:
         if args.g0 or args.theta0:
             raise ValueError("give either --cases or --g0/--theta0, not both")
-        orders = [DEFAULT_N] if args.n == "auto" else ensemble.parse_values(args.n, "--n",
-                                                                             integer=True)
-        cases = ensemble.read_cases_file(args.cases, args.perturbation, orders[0])
+        orders = [DEFAULT_N] if args.n == "auto" else sweeps.parse_values(args.n, "--n",
+                                                                           integer=True)
+        cases = sweeps.read_cases_file(args.cases, args.perturbation, orders[0])
     else:
         if not (args.g0 and args.theta0):
             raise ValueError("a sweep needs --g0 and --theta0 (or --cases FILE)")
         if args.seeds < 1:
             raise ValueError(f"--seeds must be >= 1, got {args.seeds}")
-        axes = (ensemble.parse_values(args.g0, "--g0"),
-                ensemble.parse_values(args.theta0, "--theta0"),
+        axes = (sweeps.parse_values(args.g0, "--g0"),
+                sweeps.parse_values(args.theta0, "--theta0"),
                 [DEFAULT_N] if args.n == "auto"
-                else ensemble.parse_values(args.n, "--n", integer=True))
+                else sweeps.parse_values(args.n, "--n", integer=True))
         count = math.prod(len(axis) for axis in axes) * args.seeds
         if count > validation.MAX_CASES:
             raise ValueError(f"the grid has {count} cases (--g0 x --theta0 x --n x --seeds), "
                              f"more than a sweep's {validation.MAX_CASES}: split it")
-        cases = ensemble.grid_cases(*axes, args.seeds, args.perturbation)
-    return ensemble.SweepConfig(cases=cases, t_end=args.t_end, rtol=args.rtol, atol=args.atol,
-                                w=args.w, method=args.method or (
-                                    "auto" if args.n == "auto" else "rkf45"),
-                                twin=not args.no_twin,
-                                chunk_size=(args.chunk_size if args.chunk_size is not None
-                                            else DEFAULT_AUTO_CHUNK_SIZE if args.n == "auto"
-                                            else DEFAULT_CHUNK_SIZE),
-                                early_stop=not args.no_early_stop,
-                                snapshots_for=ensemble.parse_values(
-                                    args.snapshots_for, "--snapshots-for", integer=True)
-                                if args.snapshots_for else [],
-                                snapshot_count=args.snapshots, n_auto=args.n == "auto",
-                                n_max=args.n_max, tail_tol=args.tail_tol)
+        cases = sweeps.grid_cases(*axes, args.seeds, args.perturbation)
+    return sweeps.SweepConfig(cases=cases, t_end=args.t_end, rtol=args.rtol, atol=args.atol,
+                              w=args.w, method=args.method or (
+                                  "auto" if args.n == "auto" else "rkf45"),
+                              twin=not args.no_twin,
+                              chunk_size=(args.chunk_size if args.chunk_size is not None
+                                          else DEFAULT_AUTO_CHUNK_SIZE if args.n == "auto"
+                                          else DEFAULT_CHUNK_SIZE),
+                              early_stop=not args.no_early_stop,
+                              snapshots_for=sweeps.parse_values(
+                                  args.snapshots_for, "--snapshots-for", integer=True)
+                              if args.snapshots_for else [],
+                              snapshot_count=args.snapshots, n_auto=args.n == "auto",
+                              n_max=args.n_max, tail_tol=args.tail_tol)
 
 
 def _check_rerun_options(args):
@@ -527,7 +527,7 @@ def _is_program():
 def _cmd_sweep(args):
     import numba
 
-    from . import ensemble, plots, validation
+    from . import plots, sweeps, validation
 
     if args.figure is not None:
         validation.check_output_file("--figure", args.figure)
@@ -552,18 +552,18 @@ def _cmd_sweep(args):
             _check_rerun_options(args)
             out = args.rerun_failed
             settings = {k: getattr(args, k) for k in RERUN_OPTIONS}
-            frame, reran = ensemble.rerun_failed(out, **settings, **backend)
+            frame, reran = sweeps.rerun_failed(out, **settings, **backend)
             print(f"reran {reran} failed case(s) with " + ", ".join(
                 f"{k} {getattr(args, k)}" for k in RERUN_OPTIONS))
-            config = ensemble.SweepConfig(cases=[])
+            config = sweeps.SweepConfig(cases=[])
         else:
             if args.out is None:
                 raise ValueError("a sweep needs --out DIR (or --rerun-failed DIR)")
             out = validation.check_output_directory("--out", args.out)
-            config = _sweep_config(args, ensemble)
-            frame = ensemble.run_sweep(config, out, shard=None if args.shard is None
-                                       else _parse_shard(args.shard), **backend)
-    except KeyboardInterrupt as stopped:  # ensemble.SweepInterrupted, or a Ctrl-C before it
+            config = _sweep_config(args, sweeps)
+            frame = sweeps.run_sweep(config, out, shard=None if args.shard is None
+                                     else _parse_shard(args.shard), **backend)
+    except KeyboardInterrupt as stopped:  # sweeps.SweepInterrupted, or a Ctrl-C before it
         done = (f"{stopped.done} of {stopped.total} cases done and kept in {stopped.out}; "
                 if hasattr(stopped, "done") else "")
         return _interrupted(getattr(stopped, "signum", 2),
@@ -606,7 +606,7 @@ FULL_ONLY = ("n", "theta0", "w", "q_scan", "g0", "top", "onset", "figure")
 
 
 def _cmd_stability_full(args):
-    from . import ensemble, plots, validation
+    from . import plots, sweeps, validation
     from .stability import circle, onset, paper
 
     if args.figure is not None:
@@ -634,7 +634,7 @@ def _cmd_stability_full(args):
     }
     if args.q_scan:
         out["q_scan"] = circle.paper_comparison(
-            ensemble.parse_values(args.q_scan, "--q-scan"), args.n, args.theta0, args.w)
+            sweeps.parse_values(args.q_scan, "--q-scan"), args.n, args.theta0, args.w)
     if args.g0 is not None:
         if args.g0 < 0.0:
             raise ValueError(f"--g0 must be >= 0, got {args.g0}")
