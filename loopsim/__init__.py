@@ -10,7 +10,8 @@ Layout (each layer imports only those above it):
 * ``diagnostics``, ``shapes``, ``stability``: shape measures, initial shapes,
   linear stability of the circle;
 * ``io``: table schemas, Parquet writing and reading;
-* ``api`` (``simulate``), ``ensemble`` (sweeps), ``plots``, ``cli``.
+* ``api`` (``simulate``), ``sweeps`` (``loopsim.ensemble``: its earlier name), ``plots``,
+  ``cli``.
 """
 from . import _signals
 
@@ -23,7 +24,7 @@ from ._version import __version__  # noqa: E402
 _EXPORTS = {
     "simulate": "api", "SimulationResult": "api", "evaluate_maps": "api",
     "SUMMARY_FIELDS": "api", "stability_parameter": "diagnostics",
-    "coefficients": "io", "read_results": "io", "read_snapshots": "io", "sweep": "ensemble",
+    "coefficients": "io", "read_results": "io", "read_snapshots": "io", "sweep": "sweeps",
     "summarize": "summary", "compare": "summary",
 }
 __all__ = list(_EXPORTS) + ["__version__"]

@@ -5,7 +5,7 @@ any command installs its own signal handling.  For the ``loopsim`` program (neve
 Python user importing the package) :func:`install_early` makes SIGINT and SIGTERM end the
 process in those seconds with one line and exit status 128 + signum (130, 143), without
 a traceback.  Commands replace the handler with their own while they work (a sweep keeps
-what has finished; ``ensemble.stop_on_signals``) and restore it afterwards.
+what has finished; ``sweeps.stop_on_signals``) and restore it afterwards.
 """
 import os
 import signal

@@ -19,7 +19,7 @@ import time
 
 import pandas as pd
 
-from loopsim import ensemble, io
+from loopsim import io, sweeps
 
 DETERMINISTIC = [c for c in io.RESULT_SCHEMA.names if c != "wall_s"]
 
@@ -27,7 +27,7 @@ DETERMINISTIC = [c for c in io.RESULT_SCHEMA.names if c != "wall_s"]
 def timed(config, **options):
     with tempfile.TemporaryDirectory() as out:
         start = time.perf_counter()
-        frame = ensemble.run_sweep(config, out, quiet=True, **options)
+        frame = sweeps.run_sweep(config, out, quiet=True, **options)
         return time.perf_counter() - start, frame
 
 
@@ -39,11 +39,11 @@ def main():
     args = parser.parse_args()
     from dask.distributed import Client, LocalCluster
 
-    cases = ensemble.grid_cases(ensemble.parse_values("10:350:8", "--g0"),
-                                ensemble.parse_values("6:90:8", "--theta0"), [6], 1)
-    config = ensemble.SweepConfig(cases=cases, t_end=args.t_end, chunk_size=args.chunk_size)
-    tiny = ensemble.SweepConfig(cases=cases, t_end=1e-6, chunk_size=1)
-    timed(ensemble.SweepConfig(cases=cases[:2], t_end=0.01), threads=2)  # compile here
+    cases = sweeps.grid_cases(sweeps.parse_values("10:350:8", "--g0"),
+                              sweeps.parse_values("6:90:8", "--theta0"), [6], 1)
+    config = sweeps.SweepConfig(cases=cases, t_end=args.t_end, chunk_size=args.chunk_size)
+    tiny = sweeps.SweepConfig(cases=cases, t_end=1e-6, chunk_size=1)
+    timed(sweeps.SweepConfig(cases=cases[:2], t_end=0.01), threads=2)  # compile here
 
     local, reference = timed(config, threads=2)
     print(f"# {len(cases)} cases, n = 6, t_end = {args.t_end}, chunk size {args.chunk_size} "
@@ -56,8 +56,8 @@ def main():
     client = Client(cluster)
     started = time.perf_counter() - start
     address = cluster.scheduler_address
-    warm, _ = timed(ensemble.SweepConfig(cases=cases[:args.workers * 2], t_end=0.01,
-                                         chunk_size=1), scheduler=address, threads=1)
+    warm, _ = timed(sweeps.SweepConfig(cases=cases[:args.workers * 2], t_end=0.01,
+                                       chunk_size=1), scheduler=address, threads=1)
     print(f"LocalCluster start ({args.workers} workers):           {started:7.2f} s")
     print(f"workers' first kernel load (cache):      {warm:7.2f} s")
     for write in ("worker", "client"):

@@ -18,14 +18,14 @@ import numba
 import numpy as np
 
 import loopsim
-from loopsim import batch, ensemble, integrators, shapes
+from loopsim import batch, integrators, shapes, sweeps
 from loopsim.models import local_sbt
 
 
 def timed_sweep(config, threads):
     with tempfile.TemporaryDirectory() as out:
         start = time.perf_counter()
-        frame = ensemble.run_sweep(config, out, threads=threads, quiet=True)
+        frame = sweeps.run_sweep(config, out, threads=threads, quiet=True)
         return time.perf_counter() - start, frame
 
 
@@ -37,9 +37,9 @@ def main():
     parser.add_argument("--t-end", type=float, default=10.0)
     parser.add_argument("--method", default="rkf45", help="integrator")
     args = parser.parse_args()
-    cases = ensemble.grid_cases(ensemble.parse_values(args.g0, "--g0"),
-                                ensemble.parse_values(args.theta0, "--theta0"), [args.n], 1)
-    warm = ensemble.SweepConfig(cases=cases[:2], t_end=0.01, method=args.method)
+    cases = sweeps.grid_cases(sweeps.parse_values(args.g0, "--g0"),
+                              sweeps.parse_values(args.theta0, "--theta0"), [args.n], 1)
+    warm = sweeps.SweepConfig(cases=cases[:2], t_end=0.01, method=args.method)
     timed_sweep(warm, 2)  # compile
 
     print(f"# {args.method}: {len(cases)} cases, n = {args.n}, t_end = {args.t_end}, "
@@ -47,8 +47,8 @@ def main():
     print(f"{'threads':>7} {'early_stop':>10} {'wall_s':>8} {'cases/s':>8}")
     results = {}
     for early in (False, True):
-        config = ensemble.SweepConfig(cases=cases, t_end=args.t_end, early_stop=early,
-                                      method=args.method)
+        config = sweeps.SweepConfig(cases=cases, t_end=args.t_end, early_stop=early,
+                                    method=args.method)
         for threads in (1, 2):
             wall, frame = timed_sweep(config, threads)
             results[threads, early] = (wall, frame)
@@ -74,7 +74,7 @@ def main():
     x0 = np.array([shapes.initial_shape(args.n, math.radians(c["theta0_deg"]), c["perturbation"],
                                          c["seed"]).ravel() for c in cases])
     g0 = [c["g0"] for c in cases]
-    options = ensemble.SweepConfig(cases=cases, early_stop=False).step_options()
+    options = sweeps.SweepConfig(cases=cases, early_stop=False).step_options()
     method_id = integrators.METHODS[args.method]
     numba.set_num_threads(2)
     q0 = [loopsim.stability_parameter(c["g0"], c["theta0_deg"]) for c in cases]

@@ -22,7 +22,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 import loopsim
-from loopsim import api, ensemble, io
+from loopsim import api, io, sweeps
 
 
 def flips(out, count, seed):
@@ -101,9 +101,9 @@ def main():
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         out = os.path.join(tmp, "s")
-        cases = ensemble.grid_cases([10.0, 60.0, 150.0], [30.0, 60.0], [4], seeds=1)
-        ensemble.run_sweep(ensemble.SweepConfig(cases=cases, t_end=0.3, chunk_size=2), out,
-                           threads=1, quiet=True)
+        cases = sweeps.grid_cases([10.0, 60.0, 150.0], [30.0, 60.0], [4], seeds=1)
+        sweeps.run_sweep(sweeps.SweepConfig(cases=cases, t_end=0.3, chunk_size=2), out,
+                         threads=1, quiet=True)
         flips(out, args.flips, args.seed)
         costs(out, tmp)
 

@@ -15,7 +15,7 @@ import time
 
 from scipy import stats
 
-from loopsim import ensemble
+from loopsim import sweeps
 
 
 def main():
@@ -27,15 +27,15 @@ def main():
     parser.add_argument("--methods", default="rkf45,radau5")
     parser.add_argument("--rtol", type=float, default=1e-6)
     args = parser.parse_args()
-    cases = ensemble.grid_cases([args.g0], [args.theta0], [args.n], args.seeds)
+    cases = sweeps.grid_cases([args.g0], [args.theta0], [args.n], args.seeds)
     print(f"# g0 = {args.g0}, theta0 = {args.theta0}, n = {args.n}, rtol = {args.rtol}, t = 10")
     frames = {}
     for method in args.methods.split(","):
-        config = ensemble.SweepConfig(cases=cases, method=method, early_stop=False, rtol=args.rtol,
-                                      atol=args.rtol * 1e-3)
+        config = sweeps.SweepConfig(cases=cases, method=method, early_stop=False, rtol=args.rtol,
+                                    atol=args.rtol * 1e-3)
         with tempfile.TemporaryDirectory() as out:
             start = time.perf_counter()
-            frames[method] = ensemble.run_sweep(config, out, quiet=True)
+            frames[method] = sweeps.run_sweep(config, out, quiet=True)
             wall = time.perf_counter() - start
         f = frames[method]
         print(f"{method:>7}: {len(f)} seeds, wall {wall:.1f} s, mean nfev "

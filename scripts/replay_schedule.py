@@ -7,7 +7,7 @@ prints the wall time each schedule would have taken on ``--threads`` cores:
 
 * units: the earlier local scheduler, units of ``--threads`` consecutive positions, each
   unit as long as its slowest case;
-* queue: the work queue (``ensemble._run_local``), each position in order to the first
+* queue: the work queue (``sweeps.local.run_local``), each position in order to the first
   free worker;
 * ideal: the sum over the cores.
 

@@ -8,7 +8,7 @@ exactly to n_ref for the reference run, and is integrated with radau5 (rtol
 1e-8) at both orders.  Printed per case: the n run's terminal spectral tail
 (``diagnostics.spectral_tail``), its worst transient length error, and the
 differences of terminal tilt and aspect ratio to the n_ref run: the evidence
-for the ``resolved`` thresholds (``ensemble.RESOLUTION``).
+for the ``resolved`` thresholds (``outcomes.Thresholds``).
 """
 import argparse
 import math

@@ -13,7 +13,7 @@ import pyarrow.parquet as pq
 import pytest
 
 import loopsim
-from loopsim import ensemble, io
+from loopsim import io, sweeps
 from loopsim.cli import main
 from loopsim.config import DEFAULT_AUTO_CHUNK_SIZE
 
@@ -21,10 +21,10 @@ DETERMINISTIC = [c for c in io.RESULT_SCHEMA.names if c != "wall_s"]
 
 
 def small_config(**kwargs):
-    cases = ensemble.grid_cases([10.0, 60.0, 150.0], [30.0, 60.0], [4], seeds=1)
+    cases = sweeps.grid_cases([10.0, 60.0, 150.0], [30.0, 60.0], [4], seeds=1)
     args = dict(cases=cases, t_end=0.5, chunk_size=2)
     args.update(kwargs)
-    return ensemble.SweepConfig(**args)
+    return sweeps.SweepConfig(**args)
 
 
 @pytest.mark.parametrize("theta0, theta1, ar0, ar1, ok, expected", [
@@ -35,24 +35,24 @@ def small_config(**kwargs):
     (30, 30.0, 1.0, 1.0, False, "failed"),
 ])
 def test_classification(theta0, theta1, ar0, ar1, ok, expected):
-    assert ensemble.classify(theta0, theta1, ar0, ar1, ok) == expected
+    assert sweeps.classify(theta0, theta1, ar0, ar1, ok) == expected
 
 
 def test_classification_thresholds_are_parameters():
-    loose = ensemble.Thresholds(tilt_change_deg=5.0, shape_change=0.5)
-    assert ensemble.classify(30, 27, 1.0, 1.3, True, loose) == "stable"
+    loose = sweeps.Thresholds(tilt_change_deg=5.0, shape_change=0.5)
+    assert sweeps.classify(30, 27, 1.0, 1.3, True, loose) == "stable"
 
 
 def test_resolved_flag_follows_both_thresholds():
     """A case is resolved only with a small transient length error AND a small spectral
     tail along the run (the failure modes of scripts/resolution_study.py and
     scripts/auto_study.py)."""
-    t = ensemble.Thresholds()
+    t = sweeps.Thresholds()
     assert t.resolved(2e-7, 1e-8)
     assert not t.resolved(1.5e-4, 1e-8)  # 3D at n = 6: length error, tiny tail
     assert not t.resolved(2e-7, 1.2e-3)  # in-plane at n = 6: tail, no length error
     assert not t.resolved(1.7e-7, 3.2e-5)  # 3D at n = 16 (150, 45°): 5° off in tilt
-    assert ensemble.Thresholds(resolved_length_error=1e-3).resolved(1.5e-4, 1e-8)
+    assert sweeps.Thresholds(resolved_length_error=1e-3).resolved(1.5e-4, 1e-8)
 
 
 def test_sweep_marks_under_resolved_cases(tmp_path, capsys):
@@ -87,18 +87,29 @@ def test_auto_sweep_names_n_max_for_unresolved_cases(tmp_path, capsys):
     assert "a larger --n-max than 8" in stdout
 
 
+def test_ensemble_is_the_sweeps_package_under_its_earlier_name():
+    """``loopsim.ensemble`` (sweeps' module until they became the package
+    ``loopsim.sweeps``) re-exports every public name of the package, unchanged."""
+    from loopsim import ensemble
+
+    assert sorted(ensemble.__all__) == sorted(sweeps.__all__)
+    for name in sweeps.__all__:
+        assert getattr(ensemble, name) is getattr(sweeps, name), name
+    assert loopsim.sweep is sweeps.sweep
+
+
 def test_parse_values():
-    assert ensemble.parse_values("0:10:3", "--g0") == [0.0, 5.0, 10.0]
-    assert ensemble.parse_values("6,8", "--n", integer=True) == [6, 8]
+    assert sweeps.parse_values("0:10:3", "--g0") == [0.0, 5.0, 10.0]
+    assert sweeps.parse_values("6,8", "--n", integer=True) == [6, 8]
     for bad in ("1:2", "a,b", "1:2:0", "", "nan"):
         with pytest.raises(ValueError, match="--g0"):
-            ensemble.parse_values(bad, "--g0")
+            sweeps.parse_values(bad, "--g0")
 
 
 def test_sweep_schema_round_trip_and_thread_reproducibility(tmp_path):
     config = small_config()
-    one = ensemble.run_sweep(config, str(tmp_path / "one"), threads=1, quiet=True)
-    two = ensemble.run_sweep(config, str(tmp_path / "two"), threads=2, quiet=True)
+    one = sweeps.run_sweep(config, str(tmp_path / "one"), threads=1, quiet=True)
+    two = sweeps.run_sweep(config, str(tmp_path / "two"), threads=2, quiet=True)
     numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
     assert list(one["case_id"]) == list(range(6))
     pd.testing.assert_frame_equal(one[DETERMINISTIC], two[DETERMINISTIC], check_exact=True)
@@ -110,7 +121,7 @@ def test_sweep_schema_round_trip_and_thread_reproducibility(tmp_path):
     row = one.iloc[3]
     x = np.asarray(row["x_final"]).reshape(3, 2 * row["n"] + 1)
     assert abs(loopsim.diagnostics.aspect_ratio(x) - row["aspect_ratio"]) < 1e-12
-    assert set(one["regime"]) <= set(ensemble.REGIMES)
+    assert set(one["regime"]) <= set(sweeps.REGIMES)
     assert set(one["stop_reason"]) == {"t_end"}  # t_end = 0.5: too short to call steady
     # results equal a single API run of the same case
     single = loopsim.simulate(row["g0"], row["theta0_deg"], n=4, t_span=(0, 0.5), seed=0)
@@ -137,7 +148,7 @@ def test_batch_kernel_gives_the_same_bits_on_any_number_of_lanes():
 
 def test_failures_are_rows_and_the_sweep_goes_on(tmp_path):
     config = small_config(max_steps=50)  # stable cases need fewer; 3D ones run out
-    frame = ensemble.run_sweep(config, str(tmp_path / "f"), threads=2, quiet=True)
+    frame = sweeps.run_sweep(config, str(tmp_path / "f"), threads=2, quiet=True)
     assert len(frame) == 6
     failed = frame[frame["status"] != "ok"]
     assert len(failed) > 0 and set(failed["status"]) == {"step budget exhausted"}
@@ -147,9 +158,9 @@ def test_failures_are_rows_and_the_sweep_goes_on(tmp_path):
 
 def test_changed_configuration_is_refused(tmp_path):
     out = str(tmp_path / "s")
-    ensemble.run_sweep(small_config(), out, quiet=True)
+    sweeps.run_sweep(small_config(), out, quiet=True)
     with pytest.raises(ValueError, match="different sweep.*t_end"):
-        ensemble.run_sweep(small_config(t_end=0.6), out, quiet=True)
+        sweeps.run_sweep(small_config(t_end=0.6), out, quiet=True)
 
 
 @pytest.mark.parametrize("argv, word", [
@@ -200,8 +211,8 @@ def test_resume_after_sigkill_equals_uninterrupted_run(tmp_path):
 
 def test_snapshots_for_selected_cases(tmp_path):
     out = str(tmp_path / "snap")
-    frame = ensemble.run_sweep(small_config(snapshots_for=[1, 4], snapshot_count=6), out,
-                               quiet=True)
+    frame = sweeps.run_sweep(small_config(snapshots_for=[1, 4], snapshot_count=6), out,
+                             quiet=True)
     snaps = loopsim.read_snapshots(out)
     assert sorted(snaps["case_id"].unique()) == [1, 4]
     for case_id, rows in snaps.groupby("case_id"):
@@ -219,12 +230,12 @@ def test_snapshots_do_not_change_the_results(tmp_path):
     (g0 = 150, θ0 = 60°, t = 3) and a stable one give bit-identical rows with and
     without snapshots, work counters included (dense output's RHS evaluations are not
     counted in nfev; only the wall time differs)."""
-    cases = ensemble.grid_cases([30.0, 150.0], [60.0], [6], seeds=1)
-    plain = ensemble.run_sweep(ensemble.SweepConfig(cases=cases, t_end=3.0), str(tmp_path / "a"),
-                               quiet=True)
-    traced = ensemble.run_sweep(ensemble.SweepConfig(cases=cases, t_end=3.0, snapshots_for=[0, 1],
-                                                     snapshot_count=31),
-                                str(tmp_path / "b"), quiet=True)
+    cases = sweeps.grid_cases([30.0, 150.0], [60.0], [6], seeds=1)
+    plain = sweeps.run_sweep(sweeps.SweepConfig(cases=cases, t_end=3.0), str(tmp_path / "a"),
+                             quiet=True)
+    traced = sweeps.run_sweep(sweeps.SweepConfig(cases=cases, t_end=3.0, snapshots_for=[0, 1],
+                                                 snapshot_count=31),
+                              str(tmp_path / "b"), quiet=True)
     pd.testing.assert_frame_equal(plain[DETERMINISTIC], traced[DETERMINISTIC], check_exact=True)
     assert plain.loc[1, "regime"] == "3d"
     snaps = loopsim.read_snapshots(str(tmp_path / "b"))
@@ -235,16 +246,16 @@ def test_auto_sweep_records_orders_and_methods_and_is_reproducible(tmp_path):
     """--n auto --method auto: rows carry n (the start), n_used, tail_max and method; the
     table is bit-identical on 1 and 2 threads and with snapshots (dense output, and the
     traced case climbs the same ladder)."""
-    cases = ensemble.grid_cases([30.0, 150.0], [60.0], [6], seeds=1)
+    cases = sweeps.grid_cases([30.0, 150.0], [60.0], [6], seeds=1)
     config = dict(cases=cases, t_end=0.4, method="auto", n_auto=True, n_max=12)
-    one = ensemble.run_sweep(ensemble.SweepConfig(**config), str(tmp_path / "a"), threads=1,
-                             quiet=True)
-    two = ensemble.run_sweep(ensemble.SweepConfig(**config), str(tmp_path / "b"), threads=2,
-                             quiet=True)
+    one = sweeps.run_sweep(sweeps.SweepConfig(**config), str(tmp_path / "a"), threads=1,
+                           quiet=True)
+    two = sweeps.run_sweep(sweeps.SweepConfig(**config), str(tmp_path / "b"), threads=2,
+                           quiet=True)
     numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
-    traced = ensemble.run_sweep(ensemble.SweepConfig(**config, snapshots_for=[1],
-                                                     snapshot_count=5),
-                                str(tmp_path / "c"), quiet=True)
+    traced = sweeps.run_sweep(sweeps.SweepConfig(**config, snapshots_for=[1],
+                                                 snapshot_count=5),
+                              str(tmp_path / "c"), quiet=True)
     columns = DETERMINISTIC + ["n_used", "tail_max", "method"]
     pd.testing.assert_frame_equal(one[columns], two[columns], check_exact=True)
     pd.testing.assert_frame_equal(one[columns], traced[columns], check_exact=True)

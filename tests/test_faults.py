@@ -16,23 +16,23 @@ import pyarrow.parquet as pq
 import pytest
 
 import loopsim
-from loopsim import ensemble, io, validation
+from loopsim import io, sweeps, validation
 from loopsim.cli import main
 
 DETERMINISTIC = [c for c in io.RESULT_SCHEMA.names if c != "wall_s"]
 
 
 def _config():
-    cases = ensemble.grid_cases([10.0, 60.0], [30.0], [4], seeds=1)
-    return ensemble.SweepConfig(cases=cases, t_end=0.2, chunk_size=1, snapshots_for=[1],
-                                snapshot_count=3)
+    cases = sweeps.grid_cases([10.0, 60.0], [30.0], [4], seeds=1)
+    return sweeps.SweepConfig(cases=cases, t_end=0.2, chunk_size=1, snapshots_for=[1],
+                              snapshot_count=3)
 
 
 @pytest.fixture(scope="module")
 def pristine(tmp_path_factory):
     """A 2-case sweep (one file per case, case 1 with snapshots) and its rows."""
     out = str(tmp_path_factory.mktemp("pristine") / "s")
-    frame = ensemble.run_sweep(_config(), out, threads=1, quiet=True)
+    frame = sweeps.run_sweep(_config(), out, threads=1, quiet=True)
     return out, frame
 
 
@@ -113,7 +113,7 @@ def test_damaged_snapshot_file_recomputes_its_piece(sweep, pristine):
     with pytest.raises(ValueError, match="damaged"):
         loopsim.read_snapshots(sweep)
     with pytest.warns(UserWarning, match="snapshot file"):
-        frame = ensemble.run_sweep(_config(), sweep, threads=1, quiet=True)
+        frame = sweeps.run_sweep(_config(), sweep, threads=1, quiet=True)
     _same_rows(frame, pristine[1])
     pd.testing.assert_frame_equal(loopsim.read_snapshots(sweep),
                                   loopsim.read_snapshots(pristine[0]))
@@ -422,7 +422,7 @@ def test_lost_sidecar_and_damaged_file_repaired_together(sweep, pristine):
     shutil.copy(os.path.join(sweep, io.CHUNK_PATTERN.format(0, 1)),
                 os.path.join(sweep, "chunk-0000000-0000001 (copy).parquet"))
     with pytest.warns(UserWarning) as caught:
-        frame = ensemble.run_sweep(_config(), sweep, threads=1, quiet=True)
+        frame = sweeps.run_sweep(_config(), sweep, threads=1, quiet=True)
     messages = [str(w.message) for w in caught]
     assert any("damaged" in m for m in messages) and any("stray copy" in m for m in messages)
     _same_rows(frame, pristine[1])

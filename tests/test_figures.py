@@ -238,11 +238,11 @@ def test_seed_distributions_one_histogram_per_table():
 # ---- real files: a tiny sweep, a tiny run -------------------------------------------
 @pytest.fixture(scope="module")
 def tiny(tmp_path_factory):
-    from loopsim import ensemble
+    from loopsim import sweeps
 
     base = tmp_path_factory.mktemp("tiny")
-    cases = ensemble.grid_cases([10.0, 60.0], [30.0, 60.0], [N], seeds=1)
-    ensemble.run_sweep(ensemble.SweepConfig(cases=cases, t_end=0.3), str(base / "sweep"), quiet=True)
+    cases = sweeps.grid_cases([10.0, 60.0], [30.0, 60.0], [N], seeds=1)
+    sweeps.run_sweep(sweeps.SweepConfig(cases=cases, t_end=0.3), str(base / "sweep"), quiet=True)
     run = base / "run.parquet"
     assert main(["run", "--g0", "60", "--theta0", "30", "--n", str(N), "--t-end", "1",
                  "--snapshots", "5", "--out", str(run)]) == 0

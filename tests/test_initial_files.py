@@ -8,7 +8,7 @@ import pytest
 from scipy import integrate, special
 
 import loopsim
-from loopsim import api, ensemble, io, shapes, spectral
+from loopsim import api, io, shapes, spectral, sweeps
 from loopsim.cli import main
 
 EXAMPLE = os.path.join(os.path.dirname(__file__), os.pardir, "data", "wobbly_ellipse.csv")
@@ -228,8 +228,8 @@ def test_bad_case_ids_and_flag_combinations(tmp_path, capsys):
     io.write_trajectory(run, path)
     points = write_points(tmp_path / "p.csv", _circle(40))
     sweep = str(tmp_path / "sweep")
-    ensemble.run_sweep(ensemble.SweepConfig(
-        cases=ensemble.grid_cases([10, 20], [30], [4], 1), t_end=0.01), sweep, quiet=True)
+    sweeps.run_sweep(sweeps.SweepConfig(
+        cases=sweeps.grid_cases([10, 20], [30], [4], 1), t_end=0.01), sweep, quiet=True)
     for argv, word in [
         (["--initial", path, "--case-id", "3"], "case id 3 is not in the results"),
         (["--initial", sweep, "--case-id", "7"], "case id 7 is not in the results"),

@@ -21,7 +21,8 @@ def test_cache_directory_follows_the_source(tmp_path):
                    "linalg.py", "batch.py", "spectral.py", "config.py"):
         assert any(p.endswith("loopsim/" + module) for p in sources), module
     # orchestration that no kernel imports does not invalidate the compiled kernels
-    for module in ("cli.py", "ensemble.py", "plots.py"):
+    for module in ("cli/__init__.py", "cli/sweep.py", "ensemble.py", "sweeps/runner.py",
+                   "plots.py"):
         assert not any(p.endswith("loopsim/" + module) for p in sources), module
 
 

@@ -187,13 +187,13 @@ def test_trajectory_plot_is_centred_on_the_loop(tmp_path):
 ])
 def test_output_paths_are_checked_before_any_work(argv, tmp_path, capsys, monkeypatch):
     """A bad --out or --figure is refused before any integration (one line, exit 2)."""
-    from loopsim import ensemble
+    from loopsim import sweeps
 
     def no_work(*args, **kwargs):
         raise AssertionError("integration started before the output path was checked")
 
     monkeypatch.setattr(api, "simulate", no_work)
-    monkeypatch.setattr(ensemble, "run_sweep", no_work)
+    monkeypatch.setattr(sweeps, "run_sweep", no_work)
     (tmp_path / "afile").write_text("a file where a directory is needed")
     argv = [a.replace("{tmp}", str(tmp_path)) for a in argv]
     assert main(argv) == 2

@@ -15,25 +15,25 @@ import pyarrow.parquet as pq
 import pytest
 
 import loopsim
-from loopsim import ensemble, io
+from loopsim import io, sweeps
 from loopsim.cli import main
 
 DETERMINISTIC = [c for c in io.RESULT_SCHEMA.names if c != "wall_s"]
 
 
 def config(**kwargs):
-    cases = ensemble.grid_cases([10.0, 60.0, 150.0], [30.0, 60.0], [4], seeds=1)
+    cases = sweeps.grid_cases([10.0, 60.0, 150.0], [30.0, 60.0], [4], seeds=1)
     args = dict(cases=cases, t_end=0.3, chunk_size=2)
     args.update(kwargs)
-    return ensemble.SweepConfig(**args)
+    return sweeps.SweepConfig(**args)
 
 
 @pytest.fixture(scope="module")
 def reference(tmp_path_factory):
     """The 6-case sweep run whole on this machine's threads, with snapshots of case 4."""
     out = str(tmp_path_factory.mktemp("reference") / "s")
-    frame = ensemble.run_sweep(config(snapshots_for=[4], snapshot_count=3), out, threads=2,
-                               quiet=True)
+    frame = sweeps.run_sweep(config(snapshots_for=[4], snapshot_count=3), out, threads=2,
+                             quiet=True)
     return out, frame
 
 
@@ -76,7 +76,7 @@ def test_configuration_stored_once_fingerprint_in_each_file(reference):
 def test_files_follow_the_umask(tmp_path):
     previous = os.umask(0o002)
     try:
-        ensemble.run_sweep(config(cases=config().cases[:2]), str(tmp_path / "s"), quiet=True)
+        sweeps.run_sweep(config(cases=config().cases[:2]), str(tmp_path / "s"), quiet=True)
     finally:
         os.umask(previous)
     for path in (tmp_path / "s").iterdir():
@@ -99,8 +99,8 @@ def test_old_layout_is_refused_in_one_line(tmp_path, capsys):
 def test_shards_together_equal_the_whole_sweep(tmp_path, reference):
     out = str(tmp_path / "s")
     for i in range(3):
-        ensemble.run_sweep(config(snapshots_for=[4], snapshot_count=3), out, threads=1,
-                           quiet=True, shard=(i, 3))
+        sweeps.run_sweep(config(snapshots_for=[4], snapshot_count=3), out, threads=1,
+                         quiet=True, shard=(i, 3))
     same_rows(loopsim.read_results(out), reference[1])
     pd.testing.assert_frame_equal(loopsim.read_snapshots(out), loopsim.read_snapshots(reference[0]))
 
@@ -108,9 +108,9 @@ def test_shards_together_equal_the_whole_sweep(tmp_path, reference):
 def test_changed_chunk_size_resumes_without_loss_or_duplicates(tmp_path, reference):
     out = str(tmp_path / "s")
     traced = dict(snapshots_for=[4], snapshot_count=3)  # as the reference
-    ensemble.run_sweep(config(chunk_size=2, **traced), out, quiet=True, shard=(0, 2))  # chunks 0, 2
+    sweeps.run_sweep(config(chunk_size=2, **traced), out, quiet=True, shard=(0, 2))  # chunks 0, 2
     assert sorted(io.chunk_files(out)) == [(0, 2), (4, 6)]
-    frame = ensemble.run_sweep(config(chunk_size=3, **traced), out, quiet=True)  # [0, 3), [3, 6)
+    frame = sweeps.run_sweep(config(chunk_size=3, **traced), out, quiet=True)  # [0, 3), [3, 6)
     assert sorted(io.chunk_files(out)) == [(0, 2), (2, 3), (3, 4), (4, 6)]
     same_rows(frame, reference[1])
 
@@ -118,27 +118,27 @@ def test_changed_chunk_size_resumes_without_loss_or_duplicates(tmp_path, referen
 def test_pieces_never_repeat_a_position():
     cfg = config(cases=config().cases * 4, chunk_size=5)  # 24 cases
     covered = {(0, 3): None, (3, 7): None, (12, 13): None}
-    pieces = ensemble.pending_pieces(cfg, covered)
+    pieces = sweeps.pending_pieces(cfg, covered)
     positions = [p for piece in pieces for p in piece] + [0, 1, 2, 3, 4, 5, 6, 12]
     assert sorted(positions) == list(range(24))
-    assert sorted(ensemble.case_order(24)) == list(range(24))
+    assert sorted(sweeps.case_order(24)) == list(range(24))
 
 
 def test_dask_local_cluster_equals_prange(tmp_path, reference):
     pytest.importorskip("distributed")
     out = str(tmp_path / "s")
-    frame = ensemble.run_sweep(config(snapshots_for=[4], snapshot_count=3), out, threads=1,
-                               quiet=True, local_cluster=True, workers=2)
+    frame = sweeps.run_sweep(config(snapshots_for=[4], snapshot_count=3), out, threads=1,
+                             quiet=True, local_cluster=True, workers=2)
     same_rows(frame, reference[1])
     pd.testing.assert_frame_equal(loopsim.read_snapshots(out), loopsim.read_snapshots(reference[0]))
 
 
 def test_progress_goes_to_a_log_file_with_a_cost_weighted_eta(monkeypatch):
     clock = iter([0.0, 10.0, 20.0, 20.0, 25.0, 25.0, 25.0])
-    monkeypatch.setattr(ensemble.time, "perf_counter", lambda: next(clock))
+    monkeypatch.setattr(time, "perf_counter", lambda: next(clock))
     stream = stdio.StringIO()  # not a TTY: whole lines, every `interval` seconds
     weights = {0: 1.0, 1: 1.0, 2: 8.0}
-    progress = ensemble.Progress(weights, [], stream=stream, interval=15.0)
+    progress = sweeps.Progress(weights, [], stream=stream, interval=15.0)
     progress.update([0], 0)  # t = 10: before the interval, no line
     progress.update([1], 1)  # t = 20: a line; the last case weighs 8 of 10: ETA 20 s x 8 / 2
     progress.close()
@@ -147,12 +147,12 @@ def test_progress_goes_to_a_log_file_with_a_cost_weighted_eta(monkeypatch):
     assert lines[0].startswith("cases 2/3") and "failures 1" in lines[0]
     assert "elapsed 0h00m20s ETA 0h01m20s" in lines[0], lines[0]
     stable, loop_3d = dict(g0=10.0, theta0_deg=30.0, n=4), dict(g0=150.0, theta0_deg=60.0, n=4)
-    assert ensemble.case_weight(loop_3d) == 3 * ensemble.case_weight(stable)
+    assert sweeps.case_weight(loop_3d) == 3 * sweeps.case_weight(stable)
     q0 = 150.0 * 3**0.5 / 2 / 3  # --n auto: (q0 / 11)^4 times a stable case
-    assert ensemble.case_weight(loop_3d, n_auto=True) == pytest.approx(
-        (q0 / 11.0) ** 4 * ensemble.case_weight(stable, n_auto=True), rel=1e-12)
+    assert sweeps.case_weight(loop_3d, n_auto=True) == pytest.approx(
+        (q0 / 11.0) ** 4 * sweeps.case_weight(stable, n_auto=True), rel=1e-12)
     quiet = stdio.StringIO()
-    progress = ensemble.Progress(weights, [], quiet=True, stream=quiet, interval=0.0)
+    progress = sweeps.Progress(weights, [], quiet=True, stream=quiet, interval=0.0)
     progress.update([0], 0)
     progress.close()
     assert quiet.getvalue() == ""
@@ -197,10 +197,10 @@ def test_exit_status_and_rerun_of_failed_cases(tmp_path, capsys):
     radau5; every attempt's rows are kept in _reruns/, the dataset holds each case once,
     and a further call finds nothing to rerun."""
     out = tmp_path / "s"
-    cases = ensemble.grid_cases([10.0, 60.0], [30.0], [4], seeds=1)
+    cases = sweeps.grid_cases([10.0, 60.0], [30.0], [4], seeds=1)
     cases[0].update(theta0_deg=0.0, perturbation=0.0)  # a flat circle: steady at t = 1
-    first = ensemble.run_sweep(ensemble.SweepConfig(cases=cases, t_end=3.0, max_steps=150,
-                                                    chunk_size=1), str(out), quiet=True)
+    first = sweeps.run_sweep(sweeps.SweepConfig(cases=cases, t_end=3.0, max_steps=150,
+                                                chunk_size=1), str(out), quiet=True)
     assert list(first["status"]) == ["ok", "step budget exhausted"]
     assert main(["sweep", "--rerun-failed", str(out), "--t-end", "4"]) == 2  # not a rerun option
     assert main(["sweep", "--rerun-failed", str(out), "--rtol", "1e-5", "--quiet"]) == 1
@@ -248,7 +248,7 @@ def _hold_position(monkeypatch, held, auto_release=True):
     """run_chunk, except that the task holding position ``held`` waits until every other
     task has finished (or 60 s; without ``auto_release``, until the caller sets the
     event).  Returns (finish order of positions, release event)."""
-    real, finished, release = ensemble.run_chunk, [], threading.Event()
+    real, finished, release = sweeps.run_chunk, [], threading.Event()
 
     def run_chunk(config, chunk, threads):
         if held in chunk:
@@ -259,7 +259,7 @@ def _hold_position(monkeypatch, held, auto_release=True):
             release.set()
         return output
 
-    monkeypatch.setattr(ensemble, "run_chunk", run_chunk)
+    monkeypatch.setattr(sweeps.local, "run_chunk", run_chunk)
     return finished, release
 
 
@@ -274,8 +274,8 @@ def test_free_workers_go_past_a_slow_case(tmp_path, reference, monkeypatch):
     assert batch.run_lane.targetoptions.get("nogil") is True
     finished, release = _hold_position(monkeypatch, held=0)
     start = time.monotonic()
-    frame = ensemble.run_sweep(config(snapshots_for=[4], snapshot_count=3), str(tmp_path / "q"),
-                               threads=2, quiet=True)
+    frame = sweeps.run_sweep(config(snapshots_for=[4], snapshot_count=3), str(tmp_path / "q"),
+                             threads=2, quiet=True)
     assert release.is_set() and time.monotonic() - start < 60
     assert finished == [1, 2, 3, 4, 5, 0]
     same_rows(frame, reference[1])
@@ -283,25 +283,25 @@ def test_free_workers_go_past_a_slow_case(tmp_path, reference, monkeypatch):
 
 def _interrupt_after(monkeypatch, cases):
     """SIGINT to this process, from the sweep's own thread, once ``cases`` cases are done."""
-    real = ensemble.Progress.update
+    real = sweeps.Progress.update
 
     def update(self, case_ids, failures):
         real(self, case_ids, failures)
         if self.done == cases:
             os.kill(os.getpid(), signal.SIGINT)
 
-    monkeypatch.setattr(ensemble.Progress, "update", update)
+    monkeypatch.setattr(sweeps.Progress, "update", update)
 
 
 def _resume_computes(monkeypatch, out, expected):
     """Resume the sweep in ``out`` and check that it computes exactly ``expected``
     positions; returns the table."""
     monkeypatch.undo()
-    computed, real = [], ensemble.run_chunk
-    monkeypatch.setattr(ensemble, "run_chunk",
+    computed, real = [], sweeps.run_chunk
+    monkeypatch.setattr(sweeps.local, "run_chunk",
                         lambda c, chunk, t: computed.extend(chunk) or real(c, chunk, t))
-    frame = ensemble.run_sweep(config(snapshots_for=[4], snapshot_count=3), out, threads=2,
-                               quiet=True)
+    frame = sweeps.run_sweep(config(snapshots_for=[4], snapshot_count=3), out, threads=2,
+                             quiet=True)
     assert sorted(computed) == sorted(expected)
     return frame
 
@@ -312,9 +312,9 @@ def test_stop_writes_finished_cases_past_a_running_one(tmp_path, reference, monk
     _, release = _hold_position(monkeypatch, held=0, auto_release=False)
     _interrupt_after(monkeypatch, 5)
     out = str(tmp_path / "q")
-    with pytest.raises(ensemble.SweepInterrupted):
-        ensemble.run_sweep(config(snapshots_for=[4], snapshot_count=3), out, threads=2,
-                           quiet=True)
+    with pytest.raises(sweeps.SweepInterrupted):
+        sweeps.run_sweep(config(snapshots_for=[4], snapshot_count=3), out, threads=2,
+                         quiet=True)
     release.set()  # the held worker goes on unseen, as a kernel would after a signal
     assert sorted(io.chunk_files(out)) == [(1, 2), (2, 4), (4, 6)]
     frame = _resume_computes(monkeypatch, out, [0])
@@ -328,18 +328,18 @@ def test_worker_error_is_raised_after_finished_cases_are_written(tmp_path, refer
     """An exception in a worker (not a failed case: those are rows) stops the sweep and
     is raised; the cases finished by then are written and the resume computes the rest,
     each once."""
-    real = ensemble.run_chunk
+    real = sweeps.run_chunk
 
     def run_chunk(config, chunk, threads):
         if 3 in chunk:
             raise RuntimeError("worker broke at position 3")
         return real(config, chunk, threads)
 
-    monkeypatch.setattr(ensemble, "run_chunk", run_chunk)
+    monkeypatch.setattr(sweeps.local, "run_chunk", run_chunk)
     out = str(tmp_path / "e")
     with pytest.raises(RuntimeError, match="position 3"):
-        ensemble.run_sweep(config(snapshots_for=[4], snapshot_count=3), out, threads=2,
-                           quiet=True)
+        sweeps.run_sweep(config(snapshots_for=[4], snapshot_count=3), out, threads=2,
+                         quiet=True)
     written = [p for low, high in io.chunk_files(out) for p in range(low, high)]
     assert 3 not in written and len(set(written)) == len(written)
     frame = _resume_computes(monkeypatch, out, sorted(set(range(6)) - set(written)))
@@ -362,7 +362,7 @@ def test_sweep_backend_options_checked_before_work(tmp_path, capsys, argv, word)
 
 
 def test_dask_is_imported_only_when_used():
-    code = ("import sys, loopsim.cli, loopsim.ensemble; "
+    code = ("import sys, loopsim.cli, loopsim.sweeps, loopsim.ensemble; "
             "print(any(m.split('.')[0] in ('dask', 'distributed') for m in sys.modules))")
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                             check=True)

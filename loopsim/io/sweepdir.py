@@ -1,9 +1,6 @@
-"""Tables: the declared schemas, Parquet writing with provenance, and the readers.
-
-Every table loopsim writes carries schema-level metadata (versions, the
-coefficient layout, the run or sweep configuration); files are written to a
-temporary name and renamed into place.
-"""
+"""The sweep directory's files: its layout and case order, the configuration file and
+its fingerprint, the result files' names and checks, quarantine of damaged files, and
+the readers :func:`read_results` and :func:`read_snapshots`."""
 import datetime
 import functools
 import glob
@@ -12,79 +9,14 @@ import json
 import math
 import os
 import re
-import socket
-import tempfile
 import warnings
 
-import numba
-import numpy as np
 import pandas as pd
 import pyarrow as pa
-import pyarrow.parquet as pq
 
-from . import columns, diagnostics
-from ._version import __version__
-
-COEFFICIENT_LAYOUT = (
-    "x coefficients: row-major (component x,y,z; coefficient [a0, a1..an, b1..bn]) "
-    "with f(s) = a0 + sum_k a_k cos ks + b_k sin ks, s in [0, 2pi); "
-    "multiplier: the tension Lagrange multiplier T in the same layout; "
-    "physical tension N = T + |x''|^2"
-)
-
-
-#: Summary fields, in order; they are also the sweep table's columns.
-INPUT_FIELDS = ("g0", "theta0_deg", "n", "q0", "t_end", "rtol", "atol", "w", "perturbation",
-                "seed")
-RUN_FIELDS = ("method", "n_used", "status", "t_final", "steps_accepted", "steps_rejected",
-              "nfev", "njev", "nlu", "wall_s", "tail_max")
-#: What the end state means (``loopsim.outcomes``).
-OUTCOME_FIELDS = ("regime", "resolved", "determined", "theta_uncertainty_deg",
-                  "aspect_uncertainty", "twin_nfev")
-SUMMARY_FIELDS = (INPUT_FIELDS + RUN_FIELDS + tuple(d.name for d in diagnostics.REGISTRY)
-                  + OUTCOME_FIELDS)
-
-_FLOAT = pa.float64()
-_INT = pa.int64()
-_SUMMARY_TYPES = {
-    "n": _INT, "seed": _INT, "method": pa.string(), "n_used": _INT, "status": pa.string(),
-    "steps_accepted": _INT,
-    "steps_rejected": _INT, "nfev": _INT, "njev": _INT, "nlu": _INT,
-    "regime": pa.string(), "resolved": pa.bool_(), "determined": pa.bool_(), "twin_nfev": _INT,
-    **{d.name: pa.from_numpy_dtype(np.dtype(d.dtype)) for d in diagnostics.REGISTRY},
-}
-#: The declared schema of every sweep chunk (and of :func:`read_results`); each field
-#: carries its unit and description (``loopsim.columns``) in its metadata.
-RESULT_SCHEMA = pa.schema(
-    [pa.field(name, kind, metadata=columns.field_metadata(name)) for name, kind in
-     [("case_id", _INT)]
-     + [(name, _SUMMARY_TYPES.get(name, _FLOAT)) for name in SUMMARY_FIELDS]
-     + [("stop_reason", pa.string()), ("aspect_ratio_initial", _FLOAT),
-        ("length_error_max", _FLOAT), ("x_final", pa.list_(_FLOAT))]]
-)
-
-
-def coefficients(row):
-    """The (3, 2n + 1) coefficient array of a results row's ``x_final`` (a row of
-    :func:`read_results`, a dict, or the list itself): x, y, z, each [a0, a1..an,
-    b1..bn] (``COEFFICIENT_LAYOUT``)."""
-    values = row if isinstance(row, (list, tuple, np.ndarray)) else row["x_final"]
-    return np.asarray(values, dtype=float).reshape(3, -1)
-
-
-def provenance(**extra):
-    """Schema-level metadata common to every table loopsim writes."""
-    meta = {
-        "loopsim_version": __version__,
-        "numba_version": numba.__version__,
-        "numpy_version": np.__version__,
-        "pyarrow_version": pa.__version__,
-        "created_utc": datetime.datetime.now(datetime.timezone.utc).isoformat(),
-        "coefficient_layout": COEFFICIENT_LAYOUT,
-    }
-    meta.update(extra)
-    return {key: value if isinstance(value, str) else json.dumps(value)
-            for key, value in meta.items()}
+from .. import columns
+from .integrity import CONTENT_KEY, DamagedFile, read_table_checked
+from .tables import RESULT_SCHEMA, read_metadata
 
 
 #: A sweep directory is a Parquet dataset: result files ``chunk-SSSSSSS-EEEEEEE.parquet`` at
@@ -131,34 +63,6 @@ def config_fingerprint(config):
     kept = {k: v for k, v in config.items() if k not in FINGERPRINT_IGNORES}
     text = json.dumps(kept, sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()[:16]
-
-
-#: Temporary files are named .tmp-HOST-PID-*: only their owner, or a later process on the
-#: same host once the owner has died, may remove them.
-_TEMP_NAME = re.compile(r"\.tmp-(?P<host>.+)-(?P<pid>\d+)-[^-]*$")
-
-
-def _temporary_prefix():
-    return f".tmp-{socket.gethostname()}-{os.getpid()}-"
-
-
-def remove_stale_temporaries(directory):
-    """Remove the temporary files in ``directory`` left by dead processes on this host
-    (a write cut short by a kill); files of live processes and other hosts stay."""
-    host = socket.gethostname()
-    for path in glob.glob(os.path.join(directory, ".tmp-*")):
-        match = _TEMP_NAME.match(os.path.basename(path))
-        if match is None or match["host"] != host:
-            continue
-        try:
-            os.kill(int(match["pid"]), 0)
-        except ProcessLookupError:
-            try:
-                os.remove(path)
-            except FileNotFoundError:
-                pass
-        except PermissionError:  # alive, another user's
-            pass
 
 
 def check_layout(directory):
@@ -218,145 +122,8 @@ def read_sweep_file(directory):
     return stored
 
 
-def _umask():
-    """The process umask (read without changing it where /proc allows)."""
-    try:
-        with open("/proc/self/status") as handle:
-            for line in handle:
-                if line.startswith("Umask:"):
-                    return int(line.split()[1], 8)
-    except OSError:
-        pass
-    mask = os.umask(0o022)
-    os.umask(mask)
-    return mask
-
-
-def _temporary(directory, suffix):
-    """(fd, path) of a new temporary file in ``directory`` named for this host and process,
-    with the mode an ordinary ``open`` gives (0666 less the umask; mkstemp's is 0600).
-    The directory is made if absent (output paths are checked before any work)."""
-    os.makedirs(directory, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=_temporary_prefix(), suffix=suffix, dir=directory)
-    os.fchmod(fd, 0o666 & ~_umask())
-    return fd, tmp
-
-
-def write_json_atomically(data, path):
-    """Write JSON to a temporary file in the target directory, then rename into place."""
-    fd, tmp = _temporary(os.path.dirname(os.path.abspath(path)), ".json")
-    try:
-        with os.fdopen(fd, "w") as handle:
-            json.dump(data, handle, indent=1)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-        raise
-
-
-def write_table_atomically(table, path):
-    """Write to a temporary file in the target directory, then rename into place; with
-    Parquet page checksums (CRC32) and :data:`CONTENT_KEY`, a SHA-256 of the content and
-    metadata (:func:`content_hash`), in the file's metadata."""
-    meta = {_text(k): _text(v) for k, v in (table.schema.metadata or {}).items()
-            if _text(k) != CONTENT_KEY}
-    table = table.replace_schema_metadata(dict(meta, **{CONTENT_KEY: content_hash(table, meta)}))
-    fd, tmp = _temporary(os.path.dirname(os.path.abspath(path)), ".parquet")
-    os.close(fd)
-    try:
-        pq.write_table(table, tmp, write_page_checksum=True)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-        raise
-
-
-# ---- checksums: detecting damaged files -------------------------------------------------
-#: Metadata key of a file's content hash (SHA-256, hex) written by write_table_atomically.
-CONTENT_KEY = "content_sha256"
 #: Where a sweep moves damaged result files (and their snapshots) before recomputing them.
 QUARANTINE_DIR = "_quarantine"
-
-
-def _text(value):
-    return value.decode() if isinstance(value, bytes) else str(value)
-
-
-def _hash_array(digest, array):
-    """Feed one array's values (not its buffers' layout: chunking, offsets, a list's fixed
-    or variable size do not count) into ``digest``."""
-    digest.update(f"|{len(array)}:{array.null_count}|".encode())
-    if array.null_count:
-        digest.update(np.asarray(array.is_null().to_numpy(zero_copy_only=False)).tobytes())
-    kind = array.type
-    if pa.types.is_fixed_size_list(kind):
-        digest.update(np.full(len(array), kind.list_size, np.int64).tobytes())
-        _hash_array(digest, array.flatten())
-    elif pa.types.is_list(kind) or pa.types.is_large_list(kind):
-        digest.update(array.value_lengths().fill_null(0).to_numpy(zero_copy_only=False)
-                      .astype(np.int64).tobytes())
-        _hash_array(digest, array.flatten())
-    elif pa.types.is_boolean(kind):
-        digest.update(array.fill_null(False).to_numpy(zero_copy_only=False)
-                      .astype(np.uint8).tobytes())
-    elif pa.types.is_integer(kind) or pa.types.is_floating(kind):
-        digest.update(array.fill_null(0).to_numpy(zero_copy_only=False).tobytes())
-    else:  # strings and anything else: their values as JSON
-        digest.update(json.dumps(array.to_pylist(), default=str).encode())
-
-
-def content_hash(table, metadata):
-    """SHA-256 (hex) of a table's column names, field metadata and values and of its schema metadata
-    ``metadata`` (a dict, without :data:`CONTENT_KEY` and pyarrow's own ``ARROW:`` keys):
-    written into every file loopsim writes, checked by :func:`read_table_checked`."""
-    digest = hashlib.sha256()
-    for key in sorted(metadata):
-        if key != CONTENT_KEY and not key.startswith("ARROW:"):
-            digest.update(f"{key}\0{metadata[key]}\0".encode())
-    for field, column in zip(table.schema, table.columns):
-        digest.update(f"\0column {field.name}\0".encode())
-        for key, value in sorted((field.metadata or {}).items()):  # units, descriptions
-            digest.update(b"\0field " + key + b"\0" + value)
-        _hash_array(digest, column.combine_chunks())
-    return digest.hexdigest()
-
-
-class DamagedFile(ValueError):
-    """A file that cannot be read back as written: unreadable (truncated, zero length, not
-    Parquet), a page checksum that fails, or a content hash that does not match."""
-
-    def __init__(self, path, reason):
-        super().__init__(f"{path!r} is damaged ({reason})")
-        self.path, self.reason = path, reason
-
-
-def read_table_checked(path, require_hash=False):
-    """The whole table of a Parquet file, its page checksums (where written) and its
-    content hash (:data:`CONTENT_KEY`, where present; always with ``require_hash``)
-    verified.  :class:`DamagedFile` if any fails; OSError where the file cannot be opened."""
-    try:
-        table = pq.read_table(path, page_checksum_verification=True)
-    except (FileNotFoundError, PermissionError, IsADirectoryError):
-        raise
-    except Exception as exc:  # noqa: BLE001 - whatever the reader says, the file is damaged
-        lines = str(exc).strip().splitlines()
-        raise DamagedFile(path, f"unreadable: {lines[0] if lines else type(exc).__name__}") \
-            from None
-    try:  # a flipped bit in the footer may leave names or metadata undecodable
-        meta = {_text(k): _text(v) for k, v in (table.schema.metadata or {}).items()}
-        stored = meta.get(CONTENT_KEY)
-        matches = stored is not None and content_hash(table, meta) == stored
-    except Exception as exc:  # noqa: BLE001 - anything unreadable in a file we wrote is damage
-        raise DamagedFile(path, f"unreadable: {type(exc).__name__}: {str(exc)[:80]}") from None
-    if stored is None:
-        if require_hash:
-            raise DamagedFile(path, f"no {CONTENT_KEY} in its metadata")
-        return table
-    if not matches:
-        raise DamagedFile(path, "content does not match its checksum")
-    return table
 
 
 def quarantine(directory, path, reason):
@@ -376,53 +143,6 @@ def quarantine(directory, path, reason):
     warnings.warn(f"{path!r} is damaged ({reason}): moved to {target!r}; its cases are "
                   "recomputed", stacklevel=2)
     return True
-
-
-def described(table, declarations):
-    """``table`` with each field's unit and description (``loopsim.columns``) in its
-    metadata; the schema's own metadata is kept."""
-    schema = pa.schema([field.with_metadata(columns.field_metadata(field.name, declarations))
-                        for field in table.schema], metadata=table.schema.metadata)
-    return table.cast(schema)
-
-
-def trajectory_table(result, command_line=None):
-    """One row per snapshot: time, shape coefficients, multiplier and diagnostics."""
-    k = result.x.shape[-1]
-    rows = [diagnostics.evaluate(diagnostics.State(x, u, m, result.inputs["g0"]), trajectory=True)
-            for x, u, m in zip(result.x, result.u, result.multiplier)]
-    data = {"t": pa.array(result.t, pa.float64())}
-    for d in diagnostics.REGISTRY:
-        if d.trajectory:
-            data[d.trajectory] = pa.array([r[d.trajectory] for r in rows],
-                                          pa.from_numpy_dtype(np.dtype(d.dtype)))
-    data.update({
-        "x": pa.FixedSizeListArray.from_arrays(
-            pa.array(result.x.reshape(-1), pa.float64()), 3 * k),
-        "multiplier": pa.FixedSizeListArray.from_arrays(
-            pa.array(result.multiplier.reshape(-1), pa.float64()), k),
-    })
-    table = described(pa.table(data), columns.TRAJECTORY_COLUMNS)
-    meta = provenance(summary=result.summary(), command_line=command_line or [])
-    return table.replace_schema_metadata(meta)
-
-
-def write_trajectory(result, path, command_line=None):
-    """Write a run's snapshots to Parquet (atomically)."""
-    write_table_atomically(trajectory_table(result, command_line), path)
-
-
-def read_metadata(path):
-    """Decoded schema metadata of a loopsim Parquet file."""
-    raw = pq.read_schema(path).metadata or {}
-    out = {}
-    for key, value in raw.items():
-        key, value = key.decode(), value.decode()
-        try:
-            out[key] = json.loads(value)
-        except json.JSONDecodeError:
-            out[key] = value
-    return out
 
 
 def read_snapshots(out):

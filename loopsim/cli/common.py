@@ -1,0 +1,146 @@
+"""What the commands share: exit statuses, the parser's classes and argument types,
+the integration options, and the ways a command prints, draws and ends."""
+import argparse
+import math
+import os
+import sys
+
+from ..config import (
+    DEFAULT_ATOL, DEFAULT_N, DEFAULT_N_MAX, DEFAULT_PERTURBATION, DEFAULT_RTOL, DEFAULT_T_END,
+    DEFAULT_TAIL_TOL, DEFAULT_W,
+)
+
+
+#: The integrators' names (``loopsim.integrators.METHODS``, tested equal): named here so
+#: that the command line loads no kernel, nor Numba, before it has work to do.
+METHODS = ("radau5", "rkf45")
+
+EXIT_FAILED_RUN = 1
+EXIT_USAGE = 2
+EXIT_ENVIRONMENT = 3
+
+
+class HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
+    """Shows each option's default once: not for flags, None, or help that names its own."""
+
+    def _get_help_string(self, action):
+        text = action.help or ""
+        if ("default" in text or action.default is None or action.default is False
+                or action.default == "" or action.default is argparse.SUPPRESS):
+            return text
+        return super()._get_help_string(action)
+
+
+class Parser(argparse.ArgumentParser):
+    """argparse with a one-line error instead of usage + message."""
+
+    def error(self, message):
+        self.exit(EXIT_USAGE, f"loopsim: error: {message} (see '{self.prog} --help')\n")
+
+
+def real(text):
+    """float that rejects nan and inf (argparse type)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"not a number: {text!r}") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"not a finite number: {text!r}")
+    return value
+
+
+def add_integration_options(parser):
+    """Options shared by every command that integrates loops."""
+    parser.add_argument("--t-end", type=real, default=DEFAULT_T_END, help="final time")
+    parser.add_argument("--rtol", type=real, default=DEFAULT_RTOL, help="relative tolerance")
+    parser.add_argument("--atol", type=real, default=DEFAULT_ATOL, help="absolute tolerance")
+    parser.add_argument("--w", type=real, default=DEFAULT_W, help="length-penalty rate")
+    parser.add_argument("--perturbation", type=real, default=DEFAULT_PERTURBATION, metavar="EPS",
+                        help="RMS size of the seeded initial perturbation (0: exact circle; "
+                        f"default: {DEFAULT_PERTURBATION:g}, or 0 with --initial)")
+    parser.add_argument("--method", default=None, choices=sorted(METHODS) + ["auto"],
+                        help="time integrator: rkf45 (explicit, the paper's), radau5 "
+                        "(implicit: stiff stable and in-plane loops, any n >= 8) or auto "
+                        "(chosen per case; recorded in the column method) (default: rkf45 at "
+                        "a fixed n, auto with --n auto)")
+    parser.add_argument("--no-twin", action="store_true",
+                        help="skip the twin run at 10x stricter tolerances that says whether "
+                        "each outcome is determined (about halves the cost; 'determined' is "
+                        "then empty)")
+    parser.add_argument("--n-max", type=int, default=None,
+                        help=f"with --n auto: the highest truncation order a case may reach "
+                        f"(default: {DEFAULT_N_MAX})")
+    parser.add_argument("--tail-tol", type=real, default=None,
+                        help="with --n auto: restart a case at the next order when its "
+                        "spectral tail (the top two modes' share of the deformation) passes "
+                        f"this (default: {DEFAULT_TAIL_TOL:g})")
+
+
+def check_auto_options(args, n_start=DEFAULT_N):
+    """--n-max and --tail-tol only with --n auto (refused otherwise: they would do
+    nothing), --n-max not below the ladder's start; then their defaults filled in."""
+    from .. import validation
+
+    if args.n != "auto":
+        given = [f"--{k.replace('_', '-')}" for k in ("n_max", "tail_tol")
+                 if getattr(args, k) is not None]
+        if given:
+            raise ValueError(f"{given[0]} applies only with --n auto (it would do nothing "
+                             f"at --n {args.n if args.n is not None else DEFAULT_N})")
+    if args.n_max is not None:
+        validation.check_order("--n-max", args.n_max)
+        if args.n == "auto" and args.n_max < n_start:
+            raise ValueError(f"--n-max {args.n_max} is below the order --n auto starts at "
+                             f"({n_start})")
+    args.n_max = DEFAULT_N_MAX if args.n_max is None else args.n_max
+    args.tail_tol = DEFAULT_TAIL_TOL if args.tail_tol is None else args.tail_tol
+
+
+def interrupted(signum, detail):
+    """The one way a command ends on SIGINT / SIGTERM: one line on stderr, no traceback,
+    exit status 128 + signum (130 / 143).  As the ``loopsim`` program it exits at once
+    (``os._exit``: a kernel may still run in a worker thread and cannot be cut short)."""
+    import signal
+
+    signum = signum or signal.SIGINT
+    print(f"loopsim: interrupted by {signal.Signals(signum).name}: {detail}", file=sys.stderr)
+    status = 128 + int(signum)
+    if _is_program():
+        sys.stdout.flush()
+        sys.stderr.flush()
+        from .._signals import end_children
+
+        end_children()
+        os._exit(status)
+    return status
+
+
+def _is_program():
+    """Whether this process is the ``loopsim`` command (not a caller of :func:`main`)."""
+    from .._signals import is_program
+
+    return is_program()
+
+
+def print_and_write(table, out, meta, shown=None):
+    """Print ``table`` (its ``shown`` columns) and write it to ``out`` (Parquet, atomic,
+    with loopsim's provenance and ``meta`` in its metadata) when given."""
+    import pandas as pd
+    import pyarrow as pa
+
+    from .. import io
+
+    with pd.option_context("display.width", 160, "display.max_columns", 40):
+        print(table[shown or list(table.columns)].to_string(
+            index=False, float_format=lambda v: f"{v:.4g}"))
+    if out is not None:
+        io.write_table_atomically(pa.Table.from_pandas(table, preserve_index=False)
+                                  .replace_schema_metadata(io.provenance(**meta)), out)
+        print(f"table: {out}")
+
+
+def use_agg():
+    """Figures from the command line are files: the non-interactive Agg backend."""
+    import matplotlib
+
+    matplotlib.use("Agg")

@@ -1,0 +1,154 @@
+"""``loopsim stability``: critical q of the translating circle from the full
+linearisation, or the paper's operator (``--paper``)."""
+import json
+import math
+
+from ..config import DEFAULT_W
+from .common import HelpFormatter, real, use_agg
+
+
+def add_parser(commands):
+    """The ``stability`` command and its options."""
+    stability = commands.add_parser(
+        "stability", help="critical q of the translating circle (full linearisation)",
+        description="Critical stability parameter q = g0 sin(theta0)/3 of the translating "
+        "circle from the full linearisation of loopsim's own equations: the in-plane and "
+        "out-of-plane thresholds at truncation --n (docs/stability.md). --paper prints the "
+        "paper's operator instead (its q_c = 14.561 rests on a sign error).",
+        formatter_class=HelpFormatter,
+    )
+    stability.add_argument("--json", action="store_true", help="print one JSON object")
+    full = stability.add_argument_group("full linearisation (default)")
+    full.add_argument("--n", type=int, default=None,
+                      help="truncation order of the full linearisation (>= 3; default: 16)")
+    full.add_argument("--theta0", type=real, default=None, metavar="DEG",
+                      help="tilt of the circle in (0, 90] (default: 90; the rates depend on q only)")
+    full.add_argument("--w", type=real, default=None,
+                      help=f"length-penalty rate (default: {DEFAULT_W:g})")
+    full.add_argument("--q-scan", metavar="START:STOP:NUM|v1,v2,...",
+                      help="also the largest growth rate of each sector, the paper's and the "
+                      "corrected operator at these q")
+    full.add_argument("--g0", type=real, metavar="G",
+                      help="also the spectrum at (G, --theta0): the --top largest eigenvalues "
+                      "with sector labels")
+    full.add_argument("--top", type=int, default=None,
+                      help="eigenvalues listed with --g0 (default: 12)")
+    full.add_argument("--onset", type=real, nargs=3, metavar=("EPS", "T_END", "DETECT"),
+                      help="also the q where a mode of size EPS reaches DETECT at T_END, per sector")
+    full.add_argument("--figure", metavar="PNG",
+                      help="draw growth rates vs q (paper's operator beside the full sectors)")
+    paper_group = stability.add_argument_group("the paper's operator (--paper)")
+    paper_group.add_argument("--paper", action="store_true",
+                             help="the table of the paper's operator for n = 1..--n-max instead")
+    paper_group.add_argument("--n-max", type=int, default=None,
+                             help="largest truncation order of the --paper table (default: 60)")
+    return stability
+
+
+FULL_DEFAULTS = dict(n=16, theta0=90.0, w=DEFAULT_W, top=12)
+FULL_ONLY = ("n", "theta0", "w", "q_scan", "g0", "top", "onset", "figure")
+
+
+def _cmd_stability_full(args):
+    from .. import plots, sweeps, validation
+    from ..stability import circle, onset, paper
+
+    if args.figure is not None:
+        validation.check_output_file("--figure", args.figure)
+    if args.n_max is not None:
+        raise ValueError("--n-max applies only to the --paper table")
+    for key, value in FULL_DEFAULTS.items():
+        if getattr(args, key) is None:
+            setattr(args, key, value)
+    if not 3 <= args.n <= validation.MAX_N:
+        raise ValueError(f"--n must be in 3..{validation.MAX_N} for the full linearisation, "
+                         f"got {args.n}")
+    if not 0.0 < args.theta0 <= 90.0:
+        raise ValueError(f"--theta0 must be in (0, 90], got {args.theta0}")
+    if args.w <= 0.0:
+        raise ValueError(f"--w must be > 0, got {args.w}")
+    nan_none = lambda v: None if math.isnan(v) else v  # noqa: E731
+    out = {
+        "operator": "full", "n": args.n, "theta0_deg": args.theta0, "w": args.w,
+        "q_crit_in_plane": nan_none(circle.critical_q(args.n, "in-plane", args.theta0, args.w)),
+        "q_crit_out_of_plane": nan_none(circle.critical_q(args.n, "out-of-plane", args.theta0,
+                                                          args.w)),
+        "q_crit_paper": nan_none(paper.critical_q(args.n)),
+        "q_crit_corrected_operator": nan_none(paper.critical_q(args.n, corrected=True)),
+    }
+    if args.q_scan:
+        out["q_scan"] = circle.paper_comparison(
+            sweeps.parse_values(args.q_scan, "--q-scan"), args.n, args.theta0, args.w)
+    if args.g0 is not None:
+        if args.g0 < 0.0:
+            raise ValueError(f"--g0 must be >= 0, got {args.g0}")
+        spec = circle.full_spectrum(args.g0, args.theta0, args.n, args.w)
+        top = (spec.sector != "neutral").nonzero()[0][:max(1, args.top)]
+        out["spectrum"] = {
+            "g0": args.g0, "q": spec.q, "neutral_modes": int((spec.sector == "neutral").sum()),
+            "growth_rate": {s: spec.growth_rate(s) for s in circle.SECTORS},
+            "eigenvalues_real": spec.eigenvalues.real[top].tolist(),
+            "eigenvalues_imag": spec.eigenvalues.imag[top].tolist(),
+            "sector": spec.sector[top].tolist(),
+            "out_of_plane_fraction": spec.out_of_plane_fraction[top].tolist(),
+        }
+    if args.onset:
+        eps, t_end, detect = args.onset
+        out["onset"] = {"eps": eps, "t_end": t_end, "detect": detect, **{
+            f"q_{s.replace('-', '_')}": nan_none(onset.onset_q(
+                eps, t_end, detect, args.n, s, args.theta0, args.w)) for s in circle.SECTORS}}
+    if args.figure:
+        use_agg()
+        plots.save(plots.growth_rates(args.n, theta0_deg=args.theta0, w=args.w), args.figure, dpi=120)
+        out["figure"] = args.figure
+    if args.json:
+        print(json.dumps(out))
+        return 0
+    print(f"# full linearisation about the translating circle, n = {args.n}, "
+          f"theta0 = {args.theta0} deg, w = {args.w}")
+    for key in ("q_crit_in_plane", "q_crit_out_of_plane", "q_crit_paper", "q_crit_corrected_operator"):
+        print(f"{key:<26}  {'no crossing' if out[key] is None else f'{out[key]:.11f}'}")
+    print(f"# q_crit_paper: {paper.SIGN_NOTE}")
+    if "q_scan" in out:
+        print(f"{'q':>10}  {'in-plane':>12}  {'out-of-plane':>12}  {'corrected':>12}  {'paper':>12}")
+        for row in out["q_scan"]:
+            print(f"{row['q']:>10.5g}  {row['in_plane']:>12.6g}  {row['out_of_plane']:>12.6g}  "
+                  f"{row['corrected']:>12.6g}  {row['paper']:>12.6g}")
+    if "spectrum" in out:
+        sp = out["spectrum"]
+        print(f"# spectrum at g0 = {sp['g0']}, q = {sp['q']:.6g} (largest, "
+              f"{sp['neutral_modes']} neutral modes left out)")
+        for re, im, sec in zip(sp["eigenvalues_real"], sp["eigenvalues_imag"], sp["sector"]):
+            print(f"{re:>16.9g} {im:>+12.4g}i  {sec}")
+    if "onset" in out:
+        for key, value in out["onset"].items():
+            print(f"onset {key:<16}  {value}")
+    if args.figure:
+        print(f"figure: {args.figure}")
+    return 0
+
+
+def command(args):
+    from ..stability import paper
+    from ..validation import MAX_N
+
+    if not args.paper:
+        return _cmd_stability_full(args)
+    given = [key for key in FULL_ONLY if getattr(args, key) is not None]
+    if given:
+        raise ValueError(f"--{given[0].replace('_', '-')} applies only to the full linearisation "
+                         "(drop --paper)")
+    n_max = 60 if args.n_max is None else args.n_max
+    if not 1 <= n_max <= MAX_N:  # the table to 128 took 2.5 s; 100 000 never ended
+        raise ValueError(f"--n-max must be in 1..{MAX_N}, got {n_max}")
+    table = paper.critical_q_table(n_max)
+    if args.json:
+        print(json.dumps({"operator": "paper", "note": paper.SIGN_NOTE, "critical_q": {
+            str(n): (None if math.isnan(q) else q) for n, q in table}}))
+    else:
+        print("# critical q of the paper's operator L on span{sin ks, k <= n}")
+        print(f"# note: {paper.SIGN_NOTE}")
+        print(f"{'n':>3}  q_crit")
+        for n, q in table:
+            print(f"{n:>3}  {'no crossing' if math.isnan(q) else f'{q:.11f}'}")
+    return 0

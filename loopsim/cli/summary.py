@@ -1,0 +1,53 @@
+"""``loopsim summary``: one row per cell of a sweep (regime probabilities, medians, with
+intervals), printed and optionally written and drawn."""
+import os
+
+from .common import HelpFormatter, print_and_write, use_agg
+
+
+def add_parser(commands):
+    """The ``summary`` command and its options."""
+    summary = commands.add_parser(
+        "summary", help="one row per cell of a sweep: regime probabilities, tilt and aspect "
+        "ratio medians, with 95%% intervals",
+        description="Summarise a sweep over its seeds: per cell (g0, theta0 and every other "
+        "swept input), the number of seeds, resolved and determined rows, each regime's "
+        "probability with its Wilson interval, the median and quartiles of the terminal "
+        "tilt and aspect ratio with bootstrap intervals of the medians, and the cost "
+        "(loopsim/summary.py).",
+        formatter_class=HelpFormatter,
+    )
+    summary.add_argument("sweep_dir", metavar="SWEEP_DIR", help="a sweep directory")
+    summary.add_argument("--out", metavar="FILE.parquet", help="also write the table to Parquet")
+    summary.add_argument("--seed", type=int, default=0, help="seed of the bootstrap (>= 0)")
+    summary.add_argument("--figure", metavar="PNG",
+                         help="also draw P(3D) per cell and the terminal tilt over seeds")
+    return summary
+
+
+def command(args):
+    from .. import io, summary, validation
+
+    validation.check_integer("--seed", args.seed, 0)
+    for name, path in (("--out", args.out), ("--figure", args.figure)):
+        if path is not None:
+            validation.check_output_file(name, path)
+    frame = io.read_results(args.sweep_dir)
+    table = summary.summarize(frame, seed=args.seed)
+    shown = [c for c in table.columns if c in summary.CELL_INPUTS] + [
+        "seeds", "determined", "p_stable", "p_in_plane", "p_3d", "p_3d_low", "p_3d_high",
+        "tilt_median", "tilt_median_low", "tilt_median_high"]
+    print_and_write(table, args.out, dict(table.attrs["loopsim_summary"],
+                                           summary_of=os.path.abspath(args.sweep_dir)), shown)
+    if args.figure is not None:
+        use_agg()
+        import matplotlib.pyplot as plt
+
+        from .. import plots
+
+        fig, axes = plt.subplots(1, 2, figsize=(13.5, 4.2), constrained_layout=True)
+        plots.probability_phase_diagram(table, ax=axes[0])
+        plots.tilt_distribution(table, frame, ax=axes[1])
+        plots.save(fig, args.figure, dpi=150)
+        print(f"figure: {args.figure}")
+    return 0

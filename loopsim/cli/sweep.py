@@ -1,0 +1,222 @@
+"""``loopsim sweep``: many loops (a grid or a cases file) into a sweep directory, resumed
+when re-run; also reruns of a sweep's failed cases (``--rerun-failed``)."""
+import math
+import sys
+
+from ..config import DEFAULT_AUTO_CHUNK_SIZE, DEFAULT_CHUNK_SIZE, DEFAULT_N
+from .common import (
+    EXIT_FAILED_RUN, HelpFormatter, Parser, add_integration_options, check_auto_options,
+    interrupted, real, use_agg,
+)
+
+
+def add_parser(commands):
+    """The ``sweep`` command and its options."""
+    sweep = commands.add_parser(
+        "sweep", help="run (or resume) an ensemble over (g0, theta0, n, seed) into Parquet",
+        description="Integrate many loops in parallel and write one row per case into "
+        "chunk files in DIR, a Parquet dataset (pandas.read_parquet(DIR); checked: "
+        "loopsim.read_results(DIR)). Re-running the same command resumes (also with another "
+        "--chunk-size). Exit status: 0 every case ok; 1 some case failed (its row says why; "
+        "see --rerun-failed); 2 bad input; 3 disk full, read-only filesystem or I/O error "
+        "(re-run to resume once fixed); 130 / 143 stopped by SIGINT / SIGTERM (finished "
+        "cases kept: re-run to resume).",
+        formatter_class=HelpFormatter,
+    )
+    grid = sweep.add_argument_group("cases (a grid, or --cases FILE)")
+    grid.add_argument("--g0", metavar="START:STOP:NUM|v1,v2,...", help="g0 values")
+    grid.add_argument("--theta0", metavar="START:STOP:NUM|v1,v2,...", help="theta0 values (deg)")
+    grid.add_argument("--n", default=str(DEFAULT_N), metavar="N[,N...]|auto",
+                      help="truncation orders, or auto: every case starts at n = "
+                      f"{DEFAULT_N} and climbs (up to --n-max) whenever its spectral tail passes "
+                      "--tail-tol")
+    grid.add_argument("--seeds", type=int, default=1, metavar="K", help="seeds 0..K-1 per point")
+    grid.add_argument("--cases", metavar="FILE", help="CSV/Parquet with columns g0, theta0_deg "
+                      "[, n, seed, perturbation, initial, initial_case_id] instead of a grid "
+                      "(initial: a point file or results per row, paths relative to FILE; "
+                      "theta0_deg then left empty)")
+    add_integration_options(sweep)
+    sweep.add_argument("--no-early-stop", action="store_true",
+                       help="always integrate to --t-end (default: stop once the shape and tilt "
+                       "are steady, see docs/sweeps.md)")
+    sweep.add_argument("--snapshots-for", metavar="CASE_IDS", default="",
+                       help="case ids (v1,v2,...) whose trajectories are stored as snapshots")
+    sweep.add_argument("--snapshots", type=int, default=101, metavar="K",
+                       help="states stored of each --snapshots-for trajectory: K equally "
+                       "spaced times, both ends included (as run --snapshots)")
+    sweep.add_argument("--threads", type=int, default=None, help="threads (default: all cores)")
+    sweep.add_argument("--chunk-size", type=int, default=None,
+                       help="cases per chunk file (and per Dask task; default "
+                       f"{DEFAULT_CHUNK_SIZE}, or {DEFAULT_AUTO_CHUNK_SIZE} with --n auto, "
+                       "whose cases take minutes: a SIGKILL loses the unwritten chunks); may "
+                       "change on resume")
+    sweep.add_argument("--out", metavar="DIR",
+                       help="sweep directory, made if absent (required, except with "
+                       "--rerun-failed)")
+    sweep.add_argument("--figure", metavar="PNG", help="also draw the phase diagram")
+    sweep.add_argument("--quiet", action="store_true", help="no progress line, only a summary")
+    sweep.add_argument("--progress-every", type=real, default=30.0, metavar="SECONDS",
+                       help="progress line interval when stderr is not a terminal (a log file)")
+    where = sweep.add_argument_group("where the cases run (default: this machine's threads)")
+    where.add_argument("--scheduler", metavar="ADDRESS",
+                       help="send chunks as tasks to the Dask scheduler at ADDRESS "
+                       "(tcp://host:8786); finished chunks come back and are written here")
+    where.add_argument("--dask", action="store_true",
+                       help="start a Dask LocalCluster here and send chunks to it")
+    where.add_argument("--workers", type=int, default=None,
+                       help="with --dask: worker processes, at most the cores (default: "
+                       "cores / --threads)")
+    where.add_argument("--shard", metavar="I/N",
+                       help="only chunks k with k %% N == I (0 <= I < N), for job arrays: "
+                       "N jobs with the same command and I = the array index fill DIR together")
+    where.add_argument("--rerun-failed", metavar="DIR",
+                       help="rerun only DIR's failed cases with this command's --method, --rtol "
+                       "and --atol; rows replaced, earlier rows kept in DIR/_reruns/ "
+                       "(resumable: re-run the same command)")
+    return sweep
+
+
+RERUN_OPTIONS = ("method", "rtol", "atol")  # what --rerun-failed takes from the command line
+
+
+def _parse_shard(text):
+    """'I/N' -> (I, N) with 0 <= I < N, or a one-line error."""
+    try:
+        index, count = (int(part) for part in text.split("/"))
+        if not 0 <= index < count:
+            raise ValueError
+    except ValueError:
+        raise ValueError(f"--shard must be I/N with integers 0 <= I < N, got {text!r}") from None
+    return index, count
+
+
+def _sweep_config(args, sweeps):
+    from .. import validation
+
+    check_auto_options(args)
+    if args.cases:
+        if args.g0 or args.theta0:
+            raise ValueError("give either --cases or --g0/--theta0, not both")
+        orders = [DEFAULT_N] if args.n == "auto" else sweeps.parse_values(args.n, "--n",
+                                                                           integer=True)
+        cases = sweeps.read_cases_file(args.cases, args.perturbation, orders[0])
+    else:
+        if not (args.g0 and args.theta0):
+            raise ValueError("a sweep needs --g0 and --theta0 (or --cases FILE)")
+        if args.seeds < 1:
+            raise ValueError(f"--seeds must be >= 1, got {args.seeds}")
+        axes = (sweeps.parse_values(args.g0, "--g0"),
+                sweeps.parse_values(args.theta0, "--theta0"),
+                [DEFAULT_N] if args.n == "auto"
+                else sweeps.parse_values(args.n, "--n", integer=True))
+        count = math.prod(len(axis) for axis in axes) * args.seeds
+        if count > validation.MAX_CASES:
+            raise ValueError(f"the grid has {count} cases (--g0 x --theta0 x --n x --seeds), "
+                             f"more than a sweep's {validation.MAX_CASES}: split it")
+        cases = sweeps.grid_cases(*axes, args.seeds, args.perturbation)
+    return sweeps.SweepConfig(cases=cases, t_end=args.t_end, rtol=args.rtol, atol=args.atol,
+                              w=args.w, method=args.method or (
+                                  "auto" if args.n == "auto" else "rkf45"),
+                              twin=not args.no_twin,
+                              chunk_size=(args.chunk_size if args.chunk_size is not None
+                                          else DEFAULT_AUTO_CHUNK_SIZE if args.n == "auto"
+                                          else DEFAULT_CHUNK_SIZE),
+                              early_stop=not args.no_early_stop,
+                              snapshots_for=sweeps.parse_values(
+                                  args.snapshots_for, "--snapshots-for", integer=True)
+                              if args.snapshots_for else [],
+                              snapshot_count=args.snapshots, n_auto=args.n == "auto",
+                              n_max=args.n_max, tail_tol=args.tail_tol)
+
+
+def _check_rerun_options(args):
+    """With --rerun-failed the cases and settings come from DIR: refuse the options that
+    would be ignored (given with a value other than their default)."""
+    parser = Parser(prog="loopsim")  # the sweep command alone: its defaults
+    add_parser(parser.add_subparsers(dest="command", required=True, parser_class=Parser))
+    defaults = vars(parser.parse_args(["sweep"]))
+    ignored = [key for key in ("g0", "theta0", "cases", "n", "seeds", "t_end", "w", "perturbation",
+                               "no_early_stop", "snapshots_for", "snapshots", "chunk_size",
+                               "shard", "out", "n_max", "tail_tol", "no_twin")
+               if getattr(args, key) != defaults[key]]
+    if ignored:
+        raise ValueError(f"--{ignored[0].replace('_', '-')} does not apply with --rerun-failed "
+                         f"(the cases and settings come from the sweep; only "
+                         f"{', '.join('--' + k for k in RERUN_OPTIONS)} change)")
+
+
+def command(args):
+    import numba
+
+    from .. import plots, sweeps, validation
+
+    if args.figure is not None:
+        validation.check_output_file("--figure", args.figure)
+    if args.threads is not None and not 1 <= args.threads <= numba.config.NUMBA_NUM_THREADS:
+        raise ValueError(f"--threads must be in 1..{numba.config.NUMBA_NUM_THREADS} (the "
+                         f"cores Numba may use), got {args.threads}")
+    if args.workers is not None:
+        if not args.dask:
+            raise ValueError(f"--workers needs --dask, got --workers {args.workers} without it")
+        validation.check_count("--workers", args.workers, 1, validation.MAX_WORKERS,
+                               "this machine's cores: each worker is a process that compiles "
+                               "its own kernels, and more than the cores only compete")
+    if args.scheduler is not None and args.dask:
+        raise ValueError("give --scheduler ADDRESS or --dask, not both")
+    if not args.progress_every > 0:
+        raise ValueError(f"--progress-every must be > 0, got {args.progress_every:g}")
+    backend = dict(threads=args.threads, quiet=args.quiet, command_line=sys.argv,
+                   scheduler=args.scheduler, local_cluster=args.dask, workers=args.workers,
+                   progress_interval=args.progress_every)
+    try:
+        if args.rerun_failed is not None:
+            _check_rerun_options(args)
+            out = args.rerun_failed
+            settings = {k: getattr(args, k) for k in RERUN_OPTIONS}
+            frame, reran = sweeps.rerun_failed(out, **settings, **backend)
+            print(f"reran {reran} failed case(s) with " + ", ".join(
+                f"{k} {getattr(args, k)}" for k in RERUN_OPTIONS))
+            config = sweeps.SweepConfig(cases=[])
+        else:
+            if args.out is None:
+                raise ValueError("a sweep needs --out DIR (or --rerun-failed DIR)")
+            out = validation.check_output_directory("--out", args.out)
+            config = _sweep_config(args, sweeps)
+            frame = sweeps.run_sweep(config, out, shard=None if args.shard is None
+                                     else _parse_shard(args.shard), **backend)
+    except KeyboardInterrupt as stopped:  # sweeps.SweepInterrupted, or a Ctrl-C before it
+        done = (f"{stopped.done} of {stopped.total} cases done and kept in {stopped.out}; "
+                if hasattr(stopped, "done") else "")
+        return interrupted(getattr(stopped, "signum", 2),
+                            f"{done}re-run the same command to resume")
+    counts = frame["regime"].value_counts().to_dict()
+    print(f"{len(frame)} cases in {out}: "
+          + ", ".join(f"{k} {v}" for k, v in sorted(counts.items())))
+    unresolved = frame[~frame["resolved"]]
+    if len(unresolved):
+        print(f"{len(unresolved)} of {len(frame)} cases NOT resolved at their n (transient length "
+              f"error > {config.thresholds.resolved_length_error:g} or spectral tail along the "
+              f"run > {config.thresholds.resolved_tail:g}; column 'resolved'): their "
+              f"terminal tilt and shape are not converged; rerun them with "
+              + (f"a larger --n-max than {config.n_max} (a cases file of their g0, theta0_deg "
+                 f"and seed)" if config.n_auto else "a larger --n or --n auto")
+              + " (regimes among them: " + ", ".join(
+                  f"{k} {v}" for k, v in sorted(unresolved["regime"].value_counts().items())) + ")")
+    undetermined = frame[frame["determined"].eq(False)]
+    if len(undetermined):
+        print(f"{len(undetermined)} of {len(frame)} cases NOT determined (a twin at 10x "
+              "stricter tolerances ends elsewhere; column 'determined'): their terminal tilt "
+              "is a sample of an ill-conditioned transient, not an outcome (regimes among "
+              "them: " + ", ".join(f"{k} {v}" for k, v in
+                                   sorted(undetermined["regime"].value_counts().items())) + ")")
+    if args.figure:
+        use_agg()
+        plots.save(plots.phase_diagram(frame), args.figure)
+        print(f"phase diagram: {args.figure}")
+    failed = int((frame["status"] != "ok").sum())
+    if failed:
+        print(f"{failed} of {len(frame)} cases failed (column 'status'); exit status "
+              f"{EXIT_FAILED_RUN}; rerun them with: loopsim sweep --rerun-failed {out} "
+              "--method radau5 (or another --rtol)", file=sys.stderr)
+        return EXIT_FAILED_RUN
+    return 0

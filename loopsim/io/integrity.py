@@ -1,0 +1,181 @@
+"""Files written whole or not at all, and read back verified: temporaries named for their
+process (and removed once it has died), atomic writes with Parquet page checksums and a
+content hash, and the checked reader that raises :class:`DamagedFile`."""
+import glob
+import hashlib
+import json
+import os
+import re
+import socket
+import tempfile
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+
+#: Temporary files are named .tmp-HOST-PID-*: only their owner, or a later process on the
+#: same host once the owner has died, may remove them.
+_TEMP_NAME = re.compile(r"\.tmp-(?P<host>.+)-(?P<pid>\d+)-[^-]*$")
+
+
+def _temporary_prefix():
+    return f".tmp-{socket.gethostname()}-{os.getpid()}-"
+
+
+def remove_stale_temporaries(directory):
+    """Remove the temporary files in ``directory`` left by dead processes on this host
+    (a write cut short by a kill); files of live processes and other hosts stay."""
+    host = socket.gethostname()
+    for path in glob.glob(os.path.join(directory, ".tmp-*")):
+        match = _TEMP_NAME.match(os.path.basename(path))
+        if match is None or match["host"] != host:
+            continue
+        try:
+            os.kill(int(match["pid"]), 0)
+        except ProcessLookupError:
+            try:
+                os.remove(path)
+            except FileNotFoundError:
+                pass
+        except PermissionError:  # alive, another user's
+            pass
+
+
+def _umask():
+    """The process umask (read without changing it where /proc allows)."""
+    try:
+        with open("/proc/self/status") as handle:
+            for line in handle:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except OSError:
+        pass
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def _temporary(directory, suffix):
+    """(fd, path) of a new temporary file in ``directory`` named for this host and process,
+    with the mode an ordinary ``open`` gives (0666 less the umask; mkstemp's is 0600).
+    The directory is made if absent (output paths are checked before any work)."""
+    os.makedirs(directory, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=_temporary_prefix(), suffix=suffix, dir=directory)
+    os.fchmod(fd, 0o666 & ~_umask())
+    return fd, tmp
+
+
+def write_json_atomically(data, path):
+    """Write JSON to a temporary file in the target directory, then rename into place."""
+    fd, tmp = _temporary(os.path.dirname(os.path.abspath(path)), ".json")
+    try:
+        with os.fdopen(fd, "w") as handle:
+            json.dump(data, handle, indent=1)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        raise
+
+
+def write_table_atomically(table, path):
+    """Write to a temporary file in the target directory, then rename into place; with
+    Parquet page checksums (CRC32) and :data:`CONTENT_KEY`, a SHA-256 of the content and
+    metadata (:func:`content_hash`), in the file's metadata."""
+    meta = {_text(k): _text(v) for k, v in (table.schema.metadata or {}).items()
+            if _text(k) != CONTENT_KEY}
+    table = table.replace_schema_metadata(dict(meta, **{CONTENT_KEY: content_hash(table, meta)}))
+    fd, tmp = _temporary(os.path.dirname(os.path.abspath(path)), ".parquet")
+    os.close(fd)
+    try:
+        pq.write_table(table, tmp, write_page_checksum=True)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        raise
+
+
+# ---- checksums: detecting damaged files -------------------------------------------------
+#: Metadata key of a file's content hash (SHA-256, hex) written by write_table_atomically.
+CONTENT_KEY = "content_sha256"
+
+
+def _text(value):
+    return value.decode() if isinstance(value, bytes) else str(value)
+
+
+def _hash_array(digest, array):
+    """Feed one array's values (not its buffers' layout: chunking, offsets, a list's fixed
+    or variable size do not count) into ``digest``."""
+    digest.update(f"|{len(array)}:{array.null_count}|".encode())
+    if array.null_count:
+        digest.update(np.asarray(array.is_null().to_numpy(zero_copy_only=False)).tobytes())
+    kind = array.type
+    if pa.types.is_fixed_size_list(kind):
+        digest.update(np.full(len(array), kind.list_size, np.int64).tobytes())
+        _hash_array(digest, array.flatten())
+    elif pa.types.is_list(kind) or pa.types.is_large_list(kind):
+        digest.update(array.value_lengths().fill_null(0).to_numpy(zero_copy_only=False)
+                      .astype(np.int64).tobytes())
+        _hash_array(digest, array.flatten())
+    elif pa.types.is_boolean(kind):
+        digest.update(array.fill_null(False).to_numpy(zero_copy_only=False)
+                      .astype(np.uint8).tobytes())
+    elif pa.types.is_integer(kind) or pa.types.is_floating(kind):
+        digest.update(array.fill_null(0).to_numpy(zero_copy_only=False).tobytes())
+    else:  # strings and anything else: their values as JSON
+        digest.update(json.dumps(array.to_pylist(), default=str).encode())
+
+
+def content_hash(table, metadata):
+    """SHA-256 (hex) of a table's column names, field metadata and values and of its schema metadata
+    ``metadata`` (a dict, without :data:`CONTENT_KEY` and pyarrow's own ``ARROW:`` keys):
+    written into every file loopsim writes, checked by :func:`read_table_checked`."""
+    digest = hashlib.sha256()
+    for key in sorted(metadata):
+        if key != CONTENT_KEY and not key.startswith("ARROW:"):
+            digest.update(f"{key}\0{metadata[key]}\0".encode())
+    for field, column in zip(table.schema, table.columns):
+        digest.update(f"\0column {field.name}\0".encode())
+        for key, value in sorted((field.metadata or {}).items()):  # units, descriptions
+            digest.update(b"\0field " + key + b"\0" + value)
+        _hash_array(digest, column.combine_chunks())
+    return digest.hexdigest()
+
+
+class DamagedFile(ValueError):
+    """A file that cannot be read back as written: unreadable (truncated, zero length, not
+    Parquet), a page checksum that fails, or a content hash that does not match."""
+
+    def __init__(self, path, reason):
+        super().__init__(f"{path!r} is damaged ({reason})")
+        self.path, self.reason = path, reason
+
+
+def read_table_checked(path, require_hash=False):
+    """The whole table of a Parquet file, its page checksums (where written) and its
+    content hash (:data:`CONTENT_KEY`, where present; always with ``require_hash``)
+    verified.  :class:`DamagedFile` if any fails; OSError where the file cannot be opened."""
+    try:
+        table = pq.read_table(path, page_checksum_verification=True)
+    except (FileNotFoundError, PermissionError, IsADirectoryError):
+        raise
+    except Exception as exc:  # noqa: BLE001 - whatever the reader says, the file is damaged
+        lines = str(exc).strip().splitlines()
+        raise DamagedFile(path, f"unreadable: {lines[0] if lines else type(exc).__name__}") \
+            from None
+    try:  # a flipped bit in the footer may leave names or metadata undecodable
+        meta = {_text(k): _text(v) for k, v in (table.schema.metadata or {}).items()}
+        stored = meta.get(CONTENT_KEY)
+        matches = stored is not None and content_hash(table, meta) == stored
+    except Exception as exc:  # noqa: BLE001 - anything unreadable in a file we wrote is damage
+        raise DamagedFile(path, f"unreadable: {type(exc).__name__}: {str(exc)[:80]}") from None
+    if stored is None:
+        if require_hash:
+            raise DamagedFile(path, f"no {CONTENT_KEY} in its metadata")
+        return table
+    if not matches:
+        raise DamagedFile(path, "content does not match its checksum")
+    return table

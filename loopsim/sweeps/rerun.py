@@ -1,0 +1,102 @@
+"""Reruns of a sweep's failed cases with another method or tolerances, each attempt a
+sweep of its own merged back into the directory's result files."""
+import dataclasses
+import os
+
+import pyarrow as pa
+
+from .. import io, refinement, validation
+from ..outcomes import Thresholds
+from .cases import SweepConfig
+from .orchestrate import run_sweep
+
+
+def config_from_dict(stored):
+    """The SweepConfig of a stored configuration (``_sweep.json``'s ``config``)."""
+    fields = {f.name for f in dataclasses.fields(SweepConfig)}
+    values = {k: v for k, v in stored.items() if k in fields}
+    values["thresholds"] = Thresholds(**stored.get("thresholds", {}))
+    return SweepConfig(**values)
+
+
+def rerun_failed(out, method, rtol, atol, **backend):
+    """Rerun the failed cases of sweep ``out`` with another method (None: the sweep's) or
+    tolerances.
+
+    Attempt k is a sweep of its own in ``out/_reruns/k`` (the failed cases, the settings
+    changed, no snapshots): re-running the same call resumes it.  Once it is complete,
+    every result file holding those cases is rewritten with the new rows (its metadata
+    lists the attempt) after the original was copied to ``out/_reruns/k/replaced/``.
+    Returns (the results DataFrame, the number of cases rerun).  ``backend``: as for
+    :func:`run_sweep` (threads, quiet, scheduler, local_cluster, workers, ...).
+    """
+    if method is not None:
+        validation.check_choice("--method", method, refinement.METHOD_CHOICES)
+    validation.check_real("--rtol", rtol, low=0.0, low_open=True)  # before anything is
+    validation.check_real("--atol", atol, low=0.0)  # recorded: a refused rerun leaves no trace
+    stored = io.read_sweep_file(out) if os.path.isdir(out) else None
+    if stored is None:
+        raise ValueError(f"no sweep at {out!r} (no {io.SWEEP_FILE}) to rerun failed cases of")
+    io.check_layout(out)
+    base = config_from_dict(stored["config"])
+    settings = dict(method=method or base.method, rtol=rtol, atol=atol)
+    reruns = stored.get("reruns", [])
+    open_attempt = next((r for r in reruns if not r["merged"]), None)
+    if open_attempt is not None and open_attempt["settings"] != settings:
+        raise ValueError(f"rerun {open_attempt['attempt']} of {out!r} is unfinished with "
+                         f"{open_attempt['settings']}: finish it first (same options)")
+    if open_attempt is None:
+        frame = io.read_results(out)
+        failed = sorted(int(i) for i in frame.loc[frame["status"] != "ok", "case_id"])
+        if not failed:
+            return frame, 0
+        current = {key: frame.set_index("case_id").loc[failed, key].unique().tolist()
+                   for key in ("rtol", "atol")}
+        if (current["rtol"] == [rtol] and current["atol"] == [atol]
+                and base.method == method and not reruns):
+            raise ValueError(f"the failed cases of {out!r} ran with these settings already; "
+                             "give another --method, --rtol or --atol")
+        open_attempt = dict(attempt=len(reruns) + 1, settings=settings, case_ids=failed,
+                            merged=False)
+        stored["reruns"] = reruns + [open_attempt]
+        io.write_json_atomically(stored, os.path.join(out, io.SWEEP_FILE))
+    ids = open_attempt["case_ids"]
+    directory = os.path.join(out, io.RERUN_DIR, str(open_attempt["attempt"]))
+    config = dataclasses.replace(base, cases=[base.cases[i] for i in ids], snapshots_for=[],
+                                 **settings)
+    rerun = run_sweep(config, directory, **backend)
+    _merge_rerun(out, stored["fingerprint"], directory, open_attempt["attempt"],
+                 rerun.assign(case_id=[ids[i] for i in rerun["case_id"]]))
+    open_attempt["merged"] = True
+    io.write_json_atomically(stored, os.path.join(out, io.SWEEP_FILE))
+    return io.read_results(out), len(ids)
+
+
+def _merge_rerun(out, fingerprint, directory, attempt, rows):
+    """Put the rerun ``rows`` (case ids of the sweep) into the result files holding those
+    cases; a file already carrying ``attempt`` in its metadata is done (so a merge cut
+    short by a kill resumes)."""
+    import pyarrow.parquet as pq
+
+    replaced = os.path.join(directory, "replaced")
+    os.makedirs(replaced, exist_ok=True)
+    new = pa.Table.from_pandas(rows, schema=io.RESULT_SCHEMA, preserve_index=False)
+    by_id = set(rows["case_id"])
+    for (start, stop), path in sorted(io.chunk_files(out).items()):
+        meta = io.read_metadata(path)
+        if attempt in meta.get("reruns", []):
+            continue
+        table = io.result_table(io.read_table_checked(path, io.requires_hash(
+            io.read_sweep_file(out))))
+        mask = [i in by_id for i in table.column("case_id").to_pylist()]
+        if not any(mask):
+            continue
+        io.write_table_atomically(pq.read_table(path),
+                                  os.path.join(replaced, os.path.basename(path)))
+        keep = table.filter(pa.array([not m for m in mask]))
+        ids = set(table.column("case_id").to_pylist())
+        fresh = new.filter(pa.array([i in ids for i in new.column("case_id").to_pylist()]))
+        merged = pa.concat_tables([keep, fresh]).sort_by("case_id")
+        meta = io.provenance(sweep_fingerprint=fingerprint, positions=[start, stop],
+                             reruns=meta.get("reruns", []) + [attempt])
+        io.write_table_atomically(merged.replace_schema_metadata(meta), path)
