@@ -207,9 +207,9 @@ def test_package_uses_no_private_names_of_other_modules():
     assert not offenders, "private names of other loopsim modules used:\n" + _format(offenders)
 
 
-@pytest.mark.parametrize("folder", ["tests", "scripts"])
+@pytest.mark.parametrize("folder", ["tests", "scripts", "benchmarks"])
 def test_clients_use_no_private_loopsim_names(folder):
-    """Tests and scripts use loopsim through its public names only."""
+    """Tests, scripts and benchmarks use loopsim through its public names only."""
     known = set(package_modules())
     directory = os.path.join(ROOT, folder)
     offenders = []
