@@ -351,3 +351,11 @@ def test_undetermined_rows_are_ringed_in_the_phase_diagram_and_figs_7_8():
     assert tuple(rings[0].get_offsets()[0]) == (frame["theta0_deg"].iloc[0], frame["g0"].iloc[0])
     fig = figures.q_and_tilt(frame)
     assert any(c.get_label().startswith("not determined") for c in fig.axes[0].collections)
+
+
+# ---- scripts/make_figures.py ---------------------------------------------------------
+def test_make_figures_quick_refuses_the_docs_folder():
+    done = subprocess.run(
+        [sys.executable, os.path.join("scripts", "make_figures.py"), "--quick", "--dry-run"],
+        cwd=ROOT, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2 and "not docs figures" in done.stderr

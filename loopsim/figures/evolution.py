@@ -13,7 +13,8 @@ VIEW_LIMIT = 1.6
 def time_colours(t_range):
     """(colour map, norm) of time over ``t_range`` = (first, last)."""
     first, last = float(t_range[0]), float(t_range[1])
-    return plt.get_cmap(TIME_CMAP), Normalize(vmin=first, vmax=last if last > first else first + 1.0)
+    top = last if last > first else first + 1.0
+    return plt.get_cmap(TIME_CMAP), Normalize(vmin=first, vmax=top)
 
 
 def settling_index(trajectory, tilt_tol=0.01, aspect_tol=1e-4):
@@ -37,7 +38,8 @@ def snapshot_indices(trajectory, snapshots=9, t_max="settled"):
             else len(trajectory) - 1
         last = max(last, 1) if len(trajectory) > 1 else 0
     else:
-        last = len(trajectory) - 1 if t_max is None else int(np.searchsorted(times, t_max, "right") - 1)
+        last = (len(trajectory) - 1 if t_max is None
+                else int(np.searchsorted(times, t_max, "right") - 1))
     return np.unique(np.round(np.linspace(0, max(last, 0), snapshots)).astype(int))
 
 

@@ -100,6 +100,6 @@ def gallery(frame, theta0_deg=30.0, max_shapes=8, axes=None):
     if not resolved.all():
         key.append(Line2D([], [], color="0.45", lw=0, marker="s", ms=5,
                           label="grey title: not resolved at n"))
-    fig.legend(handles=key, loc="outside lower center", ncol=len(key), fontsize=8,
-               frameon=False, title="colour: regime", title_fontsize=8)
+    fig.legend(handles=key, loc="outside lower center", ncol=len(key) if count >= 7 else 3,
+               fontsize=8, frameon=False, title="colour: regime", title_fontsize=8)
     return fig

@@ -1,4 +1,4 @@
-"""Fig. 3 (growth rates and critical q of the translating circle) and the steady branch of Fig. 8."""
+"""Fig. 3 (growth rates and critical q of the translating circle); the steady branch of Fig. 8."""
 import numpy as np
 import pandas as pd
 

@@ -12,7 +12,8 @@ from .. import spectral
 from ..plots import PAPER_BAND, REGIME_STYLE, mark_undetermined
 from ..stability import circle, paper
 
-#: Colour map of time in trajectories: light yellow (start) to dark purple (end), as the paper's Fig. 6.
+#: Colour map of time in trajectories: light yellow (start) to dark purple (end), as the
+#: paper's Fig. 6.
 TIME_CMAP = "viridis_r"
 #: Points per loop when drawing shapes.
 CURVE_POINTS = 256
@@ -107,7 +108,8 @@ def q_lines(ax, thresholds, vertical=True, band=True):
     """The thresholds as lines at constant q (vertical or horizontal), with the paper's
     empirical in-plane band when ``band``."""
     line = ax.axvline if vertical else ax.axhline
-    line(thresholds["paper"], color="k", lw=1.1, label=f"paper's linear stability, q = {thresholds['paper']:.2f}")
+    line(thresholds["paper"], color="k", lw=1.1,
+         label=f"paper's linear stability, q = {thresholds['paper']:.2f}")
     line(thresholds["in_plane"], color="k", lw=1.0, ls="--",
          label=f"full linearisation, in-plane, q = {thresholds['in_plane']:.2f}")
     line(thresholds["out_of_plane"], color="k", lw=1.0, ls=":",

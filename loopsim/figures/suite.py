@@ -95,7 +95,8 @@ def write_figures(sweep_dir, others=(), out=".", only=None, gallery_theta0=30.0,
     only = set(FIGURE_NAMES if only is None else only)
     unknown = only - set(FIGURE_NAMES)
     if unknown:
-        raise ValueError(f"unknown figure(s) {sorted(unknown)}; choose from {', '.join(FIGURE_NAMES)}")
+        raise ValueError(f"unknown figure(s) {sorted(unknown)}; "
+                         f"choose from {', '.join(FIGURE_NAMES)}")
     validation.check_count("dpi", dpi, 20, validation.MAX_DPI, "print quality; the pixel "
                            "count grows with its square")
     validation.check_tilt("gallery_theta0", gallery_theta0)
@@ -140,7 +141,8 @@ def write_figures(sweep_dir, others=(), out=".", only=None, gallery_theta0=30.0,
     if "q_tilt" in only:
         save("fig7_q_tilt", q_and_tilt(main, reference=reference))
     if "aspect" in only:
-        steady, note = (None, "steady branch not requested") if not branch else load_branch(branch_n)
+        steady, note = ((None, "steady branch not requested") if not branch
+                        else load_branch(branch_n))
         if note:
             log(note)
         save("fig8_aspect", aspect_ratio(main, steady, reference=reference, q_max=40.0))
@@ -158,5 +160,6 @@ def write_figures(sweep_dir, others=(), out=".", only=None, gallery_theta0=30.0,
         if "evolution" in only and len(runs) == 1:
             save(f"fig6_evolution_{stem}", evolution(trajectory, title=run_title(summary)))
         if "tension" in only:
-            save(f"fig1_tension_{stem}", tension_figure(trajectory, title=run_title(summary) + "\n"))
+            save(f"fig1_tension_{stem}",
+                 tension_figure(trajectory, title=run_title(summary) + "\n"))
     return written

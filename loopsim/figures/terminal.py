@@ -1,5 +1,6 @@
-"""Terminal outcomes: Fig. 7 (terminal q and tilt), Fig. 8 (aspect ratio) and their seed distributions."""
+"""Terminal outcomes: Figs. 7 (terminal q and tilt) and 8 (aspect ratio), and over seeds."""
 import numpy as np
+from matplotlib.ticker import MaxNLocator
 
 from ..plots import order_column, orders_text
 from .style import (
@@ -32,8 +33,8 @@ def q_and_tilt(frame, thresholds=None, axes=None, reference=None):
                     shift={"stable": -1.0, "in-plane": 1.0})
     for ax, xcol, ycol in ((left, "q0", "q_final"), (right, "theta0_deg", "theta_final_deg")):
         _reference(ax, reference, xcol, ycol)
-    left.set(xlabel=r"initial $q_0 = g_0 \sin\theta_0 / 3$", ylabel=r"terminal $q = g_0 \sin\theta / 3$",
-             xlim=(0, q_max), ylim=(0, q_max))
+    left.set(xlabel=r"initial $q_0 = g_0 \sin\theta_0 / 3$",
+             ylabel=r"terminal $q = g_0 \sin\theta / 3$", xlim=(0, q_max), ylim=(0, q_max))
     right.set(xlabel=r"initial tilt $\theta_0$ (deg)", ylabel=r"terminal tilt $\theta$ (deg)",
               xlim=(0, 92), ylim=(0, 92))
     handles, labels = left.get_legend_handles_labels()
@@ -120,6 +121,7 @@ def seed_distributions(frames, labels=None, axes=None, bins=12):
     right.set(xlabel="terminal " + ASPECT_LABEL, ylabel="seeds")
     for ax in (left, right):
         ax.set_ylim(0, ax.get_ylim()[1] * 1.05)
+        ax.yaxis.set_major_locator(MaxNLocator(integer=True))
     handles, names = left.get_legend_handles_labels()
     fig.legend(handles, names, fontsize=8, frameon=False, loc="outside lower center",
                ncol=min(len(names), 3))
