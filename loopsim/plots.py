@@ -69,7 +69,8 @@ def phase_diagram(frame, ax=None, paper_band=False):
     order = int(frame[order_column(frame)].max())
     resolved = frame["resolved"] if "resolved" in frame else np.ones(len(frame), bool)
     for regime, style in REGIME_STYLE.items():
-        rows = frame[(frame["regime"] == regime) & resolved]
+        failed = style["marker"] == "x"  # a failed case is drawn whether resolved or not
+        rows = frame[(frame["regime"] == regime) & (resolved | failed)]
         if len(rows):
             ax.scatter(rows["theta0_deg"], rows["g0"], s=22, linewidths=1.2, **style)
         rows = frame[(frame["regime"] == regime) & ~resolved]

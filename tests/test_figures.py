@@ -165,6 +165,12 @@ def test_phase_diagram_paper_band_adds_the_two_empirical_curves():
     assert np.allclose(g0 * np.sin(np.radians(theta)) / 3, plots.PAPER_BAND[1])
 
 
+def test_phase_diagram_draws_failed_cases_resolved_or_not():
+    frame = table().assign(resolved=False)
+    failed = [c for c in plots.phase_diagram(frame).axes[0].collections if c.get_label() == "failed"]
+    assert len(failed) == 1 and len(failed[0].get_offsets()) == (frame["regime"] == "failed").sum()
+
+
 def test_phase_diagrams_one_panel_per_sweep():
     fig = figures.phase_diagrams([table(), table(8)])
     assert len(fig.axes) == 2
@@ -276,7 +282,8 @@ def test_evolution_rows_share_one_time_range_and_one_colour_bar():
     colour_bars = [ax for ax in fig.axes if ax.get_ylabel() == "time t"]
     assert len(colour_bars) == 1
     assert colour_bars[0].get_ylim() == pytest.approx((0.0, 4.0))
-    assert [sub._suptitle.get_text() for sub in fig.subfigs[0].subfigs] == ["short", "long"]
+    assert [sub._suptitle.get_text() for sub in fig.subfigs[0].subfigs] == [
+        "short: t = 0 to 1", "long: t = 0 to 4"]
     cmap, norm = figures.time_colours((0.0, 4.0))
     side = [ax for ax in fig.axes if ax.get_title() == "side view (along x)"]
     last_short = side[0].get_lines()[-1].get_color()
@@ -354,6 +361,23 @@ def test_undetermined_rows_are_ringed_in_the_phase_diagram_and_figs_7_8():
 
 
 # ---- scripts/make_figures.py ---------------------------------------------------------
+def test_make_figures_quick_draws_every_committed_figure(tmp_path):
+    """``scripts/make_figures.py --quick`` runs every step on tiny inputs and draws every
+    PNG of docs/figures/: the one command covers the committed figures."""
+    committed = sorted(name for name in os.listdir(os.path.join(ROOT, "docs", "figures"))
+                       if name.endswith(".png"))
+    out = tmp_path / "figures"
+    done = subprocess.run(
+        [sys.executable, os.path.join("scripts", "make_figures.py"), "--quick", "--threads", "1",
+         "--runs", str(tmp_path / "runs"), "--out", str(out)],
+        cwd=ROOT, capture_output=True, text=True, timeout=900)
+    assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
+    assert sorted(os.listdir(out)) == committed
+    for name in committed:
+        assert (out / name).stat().st_size > 5_000, name
+    assert f"{len(committed)} figures in {out}" in done.stdout
+
+
 def test_make_figures_quick_refuses_the_docs_folder():
     done = subprocess.run(
         [sys.executable, os.path.join("scripts", "make_figures.py"), "--quick", "--dry-run"],

@@ -30,7 +30,11 @@ The modules: ``style`` (shared helpers and styles), ``gallery`` (Fig. 4),
 Regime colours are ``plots.REGIME_STYLE`` (the paper's: stable dark purple,
 in-plane green-blue, 3D yellow); cases not resolved at their n are hollow.
 """
-from ..plots import PAPER_BAND, REGIME_STYLE, order_column, orders_text, phase_diagram
+from .. import diagnostics, spectral, validation  # noqa: F401  (names of the former module)
+from ..plots import (
+    PAPER_BAND, REGIME_STYLE, mark_undetermined, order_column, orders_text, phase_diagram,
+)
+from ..stability import circle, paper  # noqa: F401  (names of the former module)
 from .evolution import (
     evolution, evolution_rows, settling_index, snapshot_indices, tension_figure, tension_on_shape,
     time_colours,
@@ -51,7 +55,8 @@ from .terminal import aspect_ratio, q_and_tilt, seed_distributions
 __all__ = [
     "ASPECT_LABEL", "CURVE_POINTS", "FIGURE_NAMES", "PAPER_BAND", "REGIME_STYLE", "TIME_CMAP",
     "aspect_ratio", "centred_curve", "coefficients", "default_thresholds", "evolution",
-    "evolution_rows", "gallery", "load_branch", "merged_legend_entries", "new_figure",
+    "evolution_rows", "gallery", "load_branch", "mark_undetermined", "merged_legend_entries",
+    "new_figure",
     "order_column", "orders_text", "phase_diagram", "phase_diagrams", "plane_view", "q_and_tilt",
     "q_lines", "read_run", "read_sweep", "regime_key", "regime_style", "resolved_mask",
     "run_title", "scatter_regimes", "seed_distributions", "settling_index", "side_view_basis",

@@ -95,18 +95,20 @@ def evolution(trajectory, snapshots=9, title="", fig=None, t_max="settled", t_ra
 
 def evolution_rows(trajectories, titles=None, snapshots=9, t_max="settled"):
     """Fig. 6 for several runs: one row of :func:`evolution` per trajectory table, all
-    coloured on one time range (0 to the latest time any row draws) with one colour bar."""
+    coloured on one time range (0 to the latest time any row draws) with one colour bar;
+    each row's title ends with the times it draws."""
     trajectories = list(trajectories)
     if not trajectories:
         raise ValueError("no trajectories to draw")
     titles = list(titles) if titles is not None else [""] * len(trajectories)
-    last = max(float(t["t"].to_numpy(float)[snapshot_indices(t, snapshots, t_max)[-1]])
-               for t in trajectories)
-    first = min(float(t["t"].iloc[0]) for t in trajectories)
+    ends = [float(t["t"].to_numpy(float)[snapshot_indices(t, snapshots, t_max)[-1]])
+            for t in trajectories]
+    first, last = min(float(t["t"].iloc[0]) for t in trajectories), max(ends)
     fig = plt.figure(figsize=(10.4, 3.5 * len(trajectories)), layout="constrained")
     body, side = fig.subfigures(1, 2, width_ratios=[1.0, 0.11])
     rows = body.subfigures(len(trajectories), 1) if len(trajectories) > 1 else [body]
-    for row, trajectory, title in zip(rows, trajectories, titles):
+    for row, trajectory, title, end in zip(rows, trajectories, titles, ends):
+        title = (f"{title}: " if title else "") + f"t = {trajectory['t'].iloc[0]:g} to {end:g}"
         evolution(trajectory, snapshots, title, fig=row, t_max=t_max, t_range=(first, last),
                   colorbar=False)
     cmap, norm = time_colours((first, last))
