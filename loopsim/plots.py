@@ -69,7 +69,8 @@ def phase_diagram(frame, ax=None, paper_band=False):
     order = int(frame[order_column(frame)].max())
     resolved = frame["resolved"] if "resolved" in frame else np.ones(len(frame), bool)
     for regime, style in REGIME_STYLE.items():
-        rows = frame[(frame["regime"] == regime) & resolved]
+        failed = style["marker"] == "x"  # a failed case is drawn whether resolved or not
+        rows = frame[(frame["regime"] == regime) & (resolved | failed)]
         if len(rows):
             ax.scatter(rows["theta0_deg"], rows["g0"], s=22, linewidths=1.2, **style)
         rows = frame[(frame["regime"] == regime) & ~resolved]
@@ -137,24 +138,42 @@ def save(fig, path, dpi=200):
 
 def trajectory(frame, n, title="", axes=None):
     """Snapshots of one run (a trajectory table: columns t, x, theta_deg, aspect_ratio):
-    left, the loop seen along x, centred on its centre of mass and coloured by time;
-    right, tilt and aspect ratio against time.  ``axes``: a pair, or None."""
+    left, the loop seen face-on (each snapshot, centred on its centre of mass, projected
+    on the plane of the last snapshot's two largest principal axes) and coloured by time,
+    with a colour bar; right, tilt and aspect ratio against time.  ``axes``: a pair, or
+    None."""
+    from matplotlib.colors import Normalize
+
+    from . import diagnostics
+
     if axes is None:
-        fig, axes = plt.subplots(1, 2, figsize=(9, 3.8), constrained_layout=True)
+        fig, axes = plt.subplots(1, 2, figsize=(9.6, 3.9), constrained_layout=True)
     ax_shape, ax_time = axes
     s = np.linspace(0.0, 2.0 * np.pi, 200)
-    colours = plt.cm.viridis(np.linspace(0.0, 1.0, max(len(frame), 1)))
-    for colour, coefficients in zip(colours, frame["x"]):
-        x = np.array(coefficients, dtype=float).reshape(3, 2 * n + 1)
+    times = frame["t"].to_numpy(float)
+    cmap = plt.get_cmap("viridis_r")  # light yellow first, dark purple last (as the paper)
+    norm = Normalize(vmin=times.min(), vmax=times.max() if times.max() > times.min() else times.min() + 1)
+    shapes = [np.array(c, dtype=float).reshape(3, 2 * n + 1) for c in frame["x"]]
+    _, vectors = diagnostics.principal_axes(shapes[-1])
+    major, minor = vectors[:, 2], vectors[:, 1]
+    for t, x in zip(times, shapes):
         x[:, 0] = 0.0  # centred: the mean coefficient is the centre of mass
         points = spectral.evaluate(x, s)
-        ax_shape.plot(points[1], points[2], color=colour, lw=1)
-    ax_shape.set(xlabel="y (centred)", ylabel="z (centred)", aspect="equal", title=title)
-    ax_time.plot(frame["t"], frame["theta_deg"], label="tilt θ (deg)")
+        ax_shape.plot(major @ points, minor @ points, color=cmap(norm(t)), lw=1)
+    ax_shape.set(xlabel="along the major axis", ylabel="along the minor axis",
+                 aspect="equal", title=(title + "\n" if title else "")
+                 + "face-on (the last shape's principal plane)")
+    ax_shape.title.set_fontsize(10)
+    ax_shape.figure.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax_shape,
+                             label="time t", shrink=0.9)
+    ax_time.plot(frame["t"], frame["theta_deg"], color="C0")
     ax_ratio = ax_time.twinx()
-    ax_ratio.plot(frame["t"], frame["aspect_ratio"], color="C1", label="aspect ratio")
-    ax_time.set(xlabel="t", ylabel="tilt θ (deg)")
-    ax_ratio.set_ylabel("aspect ratio (variances)", color="C1")
+    ax_ratio.plot(frame["t"], frame["aspect_ratio"], color="C1")
+    ax_time.set_xlabel("time t")
+    ax_time.set_ylabel("tilt θ (deg)", color="C0")
+    ax_ratio.set_ylabel("aspect ratio (variance along the\nmajor / minor principal axis)",
+                        color="C1")
+    ax_time.set_title("tilt (blue) and aspect ratio (orange) against time", fontsize=10)
     return ax_shape.figure
 
 

@@ -1,58 +1,59 @@
-"""Regenerate the figure suite of docs/figures/ (the paper's figures and their corrections).
+"""Regenerate every figure of docs/figures/ (the paper's, their corrections, the docs').
 
 Usage: python scripts/make_figures.py [--runs runs] [--out docs/figures] [--threads T]
-                                      [--max-wall SECONDS] [--n24] [--dry-run]
+                                      [--max-wall SECONDS] [--only NAME[,NAME...]] [--list]
+                                      [--quick] [--n24] [--dry-run]
 
-Runs what the figures need into --runs (gitignored; each step is skipped when its
-output exists, and an interrupted sweep resumes), then draws everything with
-``loopsim figures`` (loopsim/figures.py).  The steps:
+Runs what the figures need into --runs (gitignored; a finished run file is kept, a sweep
+resumes, so a second call only draws), then draws each PNG of docs/figures/ with
+loopsim.figures and loopsim.plots (the functions behind ``loopsim figures``, ``sweep
+--figure`` and ``summary --figure``, the last one through the command itself).
+``--only`` draws the named figures (stems of the PNG files, see ``--list``) and runs only
+the steps they need.  ``--quick`` exercises every step and every drawing end to end on
+tiny inputs (3 x 3 grids, t = 0.5, --n-max 8, 3 seeds, Fig. 3 and the steady branch at
+n = 6), in about a minute with a warm Numba cache: a test, never figures to commit.
 
-1. the main job, 225 loops at n = 6 (rkf45, the README's);
-2. the same grid at n = 4 (rkf45) and n = 8 (radau5): the paper's Fig. 9;
-3. 24 representative cases (θ0 = 30° across the grid's g0, five at 60°, four at 84°)
-   with automatic truncation: ``--n auto --n-max 32 --method auto --rtol 1e-7
-   --atol 1e-10`` (each starts at n = 6 from the main job's curve and climbs the
-   ladder 6, 8, 12, ... 32 whenever its spectral tail passes the default --tail-tol
-   1e-5; rows carry n_used, tail_max, resolved).  The resolved reference, drawn over
-   Figs. 7 and 8 and as its own gallery (θ0 = 30°).  Run cheapest first (increasing
-   q0), one case per chunk file, so a --max-wall cap keeps every finished case and
-   drops the highest-q0 ones;
-4. g0 = 150, θ0 = 60°: 16 seeds at n = 6 and 12 seeds with the settings of step 3
-   (seed distributions); one trajectory at n = 6 and at fixed n = 16 (radau5, t = 2,
-   kept from the earlier suite) with snapshots
-   (Fig. 6), the same start with the settings of step 3 (t = 10: the fixed n = 16 run
-   fails the `resolved` test, its spectral tail reaching 5.8e-5; this one ends at
-   n_used 20, resolved), and an in-plane loop (g0 = 60, θ0 = 30°, n = 16) for the tension
-   colouring (Fig. 1);
-5. only with --n24: 4 cases at fixed n = 24 (radau5, rtol 1e-7), a check not drawn
-   (--n auto's own tail criterion now says which rows are resolved; see README,
-   "Automatic truncation", for its check against n_used + 8).
+The steps (the runs), with the figures that need them:
 
-What was run for the committed figures (December 2026; a shared 2-core machine, one
-thread, ``nice -n 10``, another engineer's benchmark on the other core):
-``python scripts/make_figures.py --runs runs --out docs/figures --threads 1
---max-wall 1500``, after steps 1-2 had been run with the same commands (the script
-then found them complete in 3-5 s each; a first start of step 3 in the grid's order,
-stopped after 10 min with 7 cases, was set aside and the cases reordered).  Wall times:
-step 1 379 s; n = 4 135 s (1 of 225 cases failed: length error); n = 8 617 s;
-step 3 stopped at the 1500 s cap with 20 of the 24 cases done (n_used 12: 5,
-16: 5, 20: 3, 24: 4, 32: 3; 18 resolved, the other two at n_max = 32 with tail_max
-1.6e-5 and 1.7e-5); the four not run are the highest q0 (58.3, 67.7, 73.0, 116.0).
-Cost grows steeply with q0 (column wall_s): q0 <= 30.9 at most 3.3 s per case,
-q0 = 34-45 2.6-40 s, q0 = 46.2, 50.2, 54.3 (n_used 32) 304, 361 and 507 s.  rtol 1e-7
-was kept; 1e-6 was not tried.
-Step 4: seeds at n = 6 16 s; the 12 --n auto seeds 139 s (all resolved; n_used 20: 7,
-24: 5); the runs 5 s (n = 6), n = 16 8 s, the in-plane n = 16 run 7 s; the pipeline
-took 1716 s in all.  The --n auto trajectory was added afterwards and run alone with
-its step's command (12 s; n_used 20, tail_max 4.4e-6), then the two ``loopsim figures``
-commands below were re-run (17 s and 6 s).
+* ``phase_n6``: the 225-loop n = 6 grid (``--g0 10:350:15 --theta0 6:90:15``, rkf45),
+  the paper's resolution: fig4_gallery, fig5_phase, fig7_q_tilt, fig8_aspect, phase_n6;
+* ``phase_n4``, ``phase_n8``: the same grid at n = 4 (rkf45) and n = 8 (radau5):
+  fig9_phase_n;
+* ``resolved_auto``: 24 representative cases (θ0 = 30° across the grid's g0, five at
+  60°, four at 84°) with ``--n auto --n-max 32 --method auto --rtol 1e-7 --atol 1e-10``,
+  run cheapest first (increasing q0), one case per chunk file, so that a --max-wall cap
+  keeps every finished case and drops the highest-q0 ones: the reference drawn over
+  Figs. 7 and 8 and fig4_gallery_resolved_auto;
+* ``seeds_n6``, ``seeds_auto``: g0 = 150, θ0 = 60°, 16 seeds at n = 6 and 12 with the
+  settings of ``resolved_auto``: seed_distributions;
+* ``g150_t60_n6``, ``g150_t60_n16``, ``g150_t60_auto``: that start at n = 6 (t = 10),
+  n = 16 (radau5, t = 2) and with the settings of ``resolved_auto`` (t = 10), 41
+  snapshots each: fig6_evolution (one row each, one time scale);
+* ``g60_t30_n16``: the in-plane loop g0 = 60, θ0 = 30°, n = 16 (radau5):
+  fig1_tension_g60_t30_n16;
+* ``main_job``: the README's main job, its exact command (72 loops at ``--n auto``,
+  with twins) into ``runs/phase``: phase_main;
+* ``phase_auto``: the 225-loop grid with ``--n auto --method auto`` (rtol 1e-6):
+  phase_auto, fig7_q_tilt_phase_auto, fig8_aspect_phase_auto.  Hours on 2 cores.  The
+  committed ones were computed with the earlier ``--n auto`` (docs/earlier-n-auto.md);
+  a rerun draws today's, whose numbers differ from that page's;
+* ``seed_cells``: docs/distributions.md's four cells (g0 = 100, 150 x θ0 = 45, 60°),
+  16 seeds each at ``--n auto`` with twins: seed_cells (``loopsim summary --figure``);
+* ``resolved_n24`` (only with --n24): 4 cases at fixed n = 24 (radau5, rtol 1e-7), a
+  check not drawn.
 
-Nothing here is random beyond the seeded initial perturbations (seed 0 unless
-stated), so a rerun reproduces the tables.
+The figure suite's own runs (all but ``main_job`` and ``seed_cells``) skip the twin
+(``--no-twin``): these figures draw no determinacy, and the twin would cost 1.5-2.5x.
+Fig. 3 needs no run.  Nothing here is random beyond the seeded initial perturbations
+(seed 0 unless stated), so a rerun reproduces the tables.
+
+What was run for the committed figures, and when: docs/figures.md ("Regenerating the
+figures").
 """
 import argparse
 import os
 import shlex
+import shutil
 import signal
 import subprocess
 import sys
@@ -63,23 +64,34 @@ import pandas as pd
 
 from loopsim.io import case_order
 
+#: The paper's grid (225 loops) and its --quick stand-in (9 loops).
 GRID = ["--g0", "10:350:15", "--theta0", "6:90:15"]
+QUICK_GRID = ["--g0", "10:150:3", "--theta0", "10:90:3"]
+#: The README's main job (README.md, first code block), its grid and its --quick stand-in.
+MAIN_JOB = ["--g0", "10:150:8", "--theta0", "10:90:9", "--n", "auto"]
+QUICK_MAIN_JOB = ["--g0", "10:150:3", "--theta0", "10:90:3", "--n", "auto"]
 #: Resolved runs: automatic truncation (start at n = 6, climb the ladder 6, 8, 12, ... 32
 #: whenever the spectral tail passes the default --tail-tol 1e-5), integrator chosen per case.
 RESOLVED = ["--n", "auto", "--n-max", "32", "--method", "auto", "--rtol", "1e-7", "--atol", "1e-10"]
 #: A fixed-n check at n = 24 (radau5), not drawn: only with --n24.
 FIXED_N24 = ["--method", "radau5", "--rtol", "1e-7", "--atol", "1e-10"]
+#: Figures of loopsim figures at this resolution; the phase diagrams as sweep --figure draws them.
+DPI, PHASE_DPI = 110, 200
 
 
-def resolved_cases(path):
+def resolved_cases(path, quick=False):
     """The 24 representative cases (the main grid's g0 values): θ0 = 30° across g0,
-    five at θ0 = 60° and four at 84°.  Written so that the sweep runs them in order of
-    increasing q0 (cost grows steeply with q0): the sweep's k-th chunk of one case is
-    case ``case_order(24)[k]``, so a --max-wall cap drops the highest-q0 cases first."""
+    five at θ0 = 60° and four at 84° (--quick: three at 30°, one at 60°).  Written so that
+    the sweep runs them in order of increasing q0 (cost grows steeply with q0): the
+    sweep's k-th chunk of one case is case ``case_order(24)[k]``, so a --max-wall cap drops
+    the highest-q0 cases first."""
     g = np.linspace(10, 350, 15)
-    rows = [(g0, 30.0) for g0 in g]
-    rows += [(g[i], 60.0) for i in (1, 2, 4, 6, 10)]
-    rows += [(g[i], 84.0) for i in (1, 4, 8, 14)]
+    if quick:
+        rows = [(10.0, 30.0), (60.0, 30.0), (100.0, 30.0), (60.0, 60.0)]
+    else:
+        rows = [(g0, 30.0) for g0 in g]
+        rows += [(g[i], 60.0) for i in (1, 2, 4, 6, 10)]
+        rows += [(g[i], 84.0) for i in (1, 4, 8, 14)]
     rows.sort(key=lambda r: r[0] * np.sin(np.radians(r[1])))
     table = [None] * len(rows)
     for k, case_id in enumerate(case_order(len(rows))):
@@ -94,80 +106,138 @@ def n24_cases(path):
     pd.DataFrame(rows, columns=["g0", "theta0_deg"]).assign(n=24, seed=0).to_csv(path, index=False)
 
 
-def steps(runs, threads, n24=False):
-    """(output path, command, capped) in order; a command is a list of loopsim arguments;
-    ``capped``: the resolved sweeps, which --max-wall may stop (they run one case per chunk
-    file, so every finished case is kept and a re-run resumes)."""
+def steps(runs, threads, quick=False, n24=False):
+    """{name: (output path, loopsim arguments, capped)} in running order; ``capped``: the
+    --n auto sweeps, which --max-wall may stop (they keep every finished case, and a
+    re-run resumes)."""
     t = ["--threads", str(threads), "--quiet"]
     fig = os.path.join(runs, "fig")
     one = ["--chunk-size", "1"]
-    out = [
-        (os.path.join(runs, "phase"), ["sweep", *GRID, "--out", os.path.join(runs, "phase"), *t], False),
-        (os.path.join(runs, "phase_n4"),
-         ["sweep", *GRID, "--n", "4", "--out", os.path.join(runs, "phase_n4"), *t], False),
-        (os.path.join(runs, "phase_n8"),
-         ["sweep", *GRID, "--n", "8", "--method", "radau5", "--out", os.path.join(runs, "phase_n8"),
-          *t], False),
-        (os.path.join(runs, "resolved_auto"),
-         ["sweep", "--cases", os.path.join(fig, "resolved_cases.csv"), *RESOLVED, *one,
-          "--out", os.path.join(runs, "resolved_auto"), *t], True),
-        (os.path.join(runs, "seeds_n6"),
-         ["sweep", "--g0", "150", "--theta0", "60", "--n", "6", "--seeds", "16",
-          "--out", os.path.join(runs, "seeds_n6"), *t], False),
-        (os.path.join(runs, "seeds_auto"),
-         ["sweep", "--g0", "150", "--theta0", "60", "--seeds", "12", *RESOLVED, *one,
-          "--out", os.path.join(runs, "seeds_auto"), *t], True),
-        (os.path.join(fig, "g150_t60_n6.parquet"),
-         ["run", "--g0", "150", "--theta0", "60", "--n", "6", "--t-end", "10", "--snapshots", "41",
-          "--out", os.path.join(fig, "g150_t60_n6.parquet")], False),
-        (os.path.join(fig, "g150_t60_n16.parquet"),
-         ["run", "--g0", "150", "--theta0", "60", "--n", "16", "--method", "radau5", "--t-end", "2",
-          "--snapshots", "41", "--out", os.path.join(fig, "g150_t60_n16.parquet")], False),
-        (os.path.join(fig, "g150_t60_auto.parquet"),
-         ["run", "--g0", "150", "--theta0", "60", *RESOLVED, "--t-end", "10", "--snapshots", "41",
-          "--out", os.path.join(fig, "g150_t60_auto.parquet")], False),
-        (os.path.join(fig, "g60_t30_n16.parquet"),
-         ["run", "--g0", "60", "--theta0", "30", "--n", "16", "--method", "radau5", "--t-end", "10",
-          "--snapshots", "21", "--out", os.path.join(fig, "g60_t30_n16.parquet")], False),
-    ]
+    lean = ["--no-twin"]  # the figure suite's own runs: no determinacy drawn
+    grid, main_job = (QUICK_GRID, QUICK_MAIN_JOB) if quick else (GRID, MAIN_JOB)
+    resolved = RESOLVED
+    short, short_run = [], ["--t-end", "10"]
+    seeds_n6, seeds_auto, seeds_cells, snapshots = "16", "12", "16", "41"
+    if quick:
+        resolved = [*RESOLVED[:2], "--n-max", "8", *RESOLVED[4:]]
+        short = short_run = ["--t-end", "0.5"]
+        seeds_n6 = seeds_auto = seeds_cells = "3"
+        snapshots = "5"
+    auto_quick = ["--n-max", "8"] if quick else []
+
+    def sweep(name, *args, capped=False):
+        path = os.path.join(runs, name)
+        return name, (path, ["sweep", *args, *short, "--out", path, *t], capped)
+
+    def run(name, *args):
+        path = os.path.join(fig, f"{name}.parquet")
+        return name, (path, ["run", *args, "--snapshots", snapshots, *lean, "--out", path], False)
+
+    out = dict([
+        run("g150_t60_n6", "--g0", "150", "--theta0", "60", "--n", "6", *short_run),
+        run("g150_t60_n16", "--g0", "150", "--theta0", "60", "--n", "16", "--method", "radau5",
+            "--t-end", "0.5" if quick else "2"),
+        run("g150_t60_auto", "--g0", "150", "--theta0", "60", *resolved, *short_run),
+        run("g60_t30_n16", "--g0", "60", "--theta0", "30", "--n", "16", "--method", "radau5",
+            *short_run),
+        sweep("seeds_n6", "--g0", "150", "--theta0", "60", "--n", "6", "--seeds", seeds_n6, *lean),
+        sweep("seeds_auto", "--g0", "150", "--theta0", "60", "--seeds", seeds_auto, *resolved,
+              *lean, *one, capped=True),
+        sweep("phase_n6", *grid, *lean),
+        sweep("phase_n4", *grid, "--n", "4", *lean),
+        sweep("phase_n8", *grid, "--n", "8", "--method", "radau5", *lean),
+        sweep("resolved_auto", "--cases", os.path.join(fig, "resolved_cases.csv"), *resolved,
+              *lean, *one, capped=True),
+        sweep("phase", *main_job, *auto_quick, capped=True),
+        sweep("seed_cells", "--g0", "100,150", "--theta0", "45,60", "--seeds", seeds_cells,
+              "--n", "auto", *auto_quick, capped=True),
+        sweep("phase_auto", *grid, "--n", "auto", "--method", "auto", *auto_quick, *lean,
+              capped=True),
+    ])
+    out["main_job"] = out.pop("phase")  # the README's --out runs/phase, under a clearer name
     if n24:
-        out.append((os.path.join(runs, "resolved_n24"),
-                    ["sweep", "--cases", os.path.join(fig, "n24_cases.csv"), *FIXED_N24, *one,
-                     "--out", os.path.join(runs, "resolved_n24"), *t], True))
+        out.update([sweep("resolved_n24", "--cases", os.path.join(fig, "n24_cases.csv"),
+                          *FIXED_N24, *one, *lean, capped=True)])
     return out
 
 
-def figure_commands(runs, out):
-    """Two ``loopsim figures`` calls: everything but the tension colouring (3D runs for
-    Fig. 6), then the tension colouring of the in-plane loop only."""
-    fig = os.path.join(runs, "fig")
-    sweeps = [os.path.join(runs, d) for d in ("phase", "phase_n4", "phase_n8", "resolved_auto",
-                                              "seeds_n6", "seeds_auto")]
-    evolution = [os.path.join(fig, f) for f in ("g150_t60_n6.parquet", "g150_t60_n16.parquet",
-                                                "g150_t60_auto.parquet")]
-    return [
-        ["figures", *sweeps, *evolution, "--out", out, "--only",
-         "stability,gallery,phase,q_tilt,aspect,phase_n,seeds,evolution"],
-        ["figures", sweeps[0], os.path.join(fig, "g60_t30_n16.parquet"), "--out", out,
-         "--only", "tension"],
-    ]
+def targets(quick=False):
+    """{figure stem: (steps it needs, how it is drawn)}: every PNG of docs/figures/.  How:
+    ("figures", main step, other steps, loopsim figures' name, its output stem), ("phase",
+    step) for a plain phase diagram, ("summary", step) for ``loopsim summary --figure``,
+    or ("stability",)."""
+    runs3 = ["g150_t60_n6", "g150_t60_n16", "g150_t60_auto"]
+    return {
+        "fig1_tension_g60_t30_n16": (["g60_t30_n16"],
+                                     ("figures", "seeds_n6", ["g60_t30_n16"], "tension",
+                                      "fig1_tension_g60_t30_n16")),
+        "fig3_stability": ([], ("stability",)),
+        "fig4_gallery": (["phase_n6"], ("figures", "phase_n6", [], "gallery", "fig4_gallery")),
+        "fig4_gallery_resolved_auto": (["resolved_auto"],
+                                       ("figures", "phase_n6", ["resolved_auto"], "gallery",
+                                        "fig4_gallery_resolved_auto")),
+        "fig5_phase": (["phase_n6"], ("figures", "phase_n6", [], "phase", "fig5_phase")),
+        "fig6_evolution": (runs3, ("figures", "seeds_n6", runs3, "evolution", "fig6_evolution")),
+        "fig7_q_tilt": (["phase_n6", "resolved_auto"],
+                        ("figures", "phase_n6", ["resolved_auto"], "q_tilt", "fig7_q_tilt")),
+        "fig7_q_tilt_phase_auto": (["phase_auto"],
+                                   ("figures", "phase_auto", [], "q_tilt", "fig7_q_tilt")),
+        "fig8_aspect": (["phase_n6", "resolved_auto"],
+                        ("figures", "phase_n6", ["resolved_auto"], "aspect", "fig8_aspect")),
+        "fig8_aspect_phase_auto": (["phase_auto"],
+                                   ("figures", "phase_auto", [], "aspect", "fig8_aspect")),
+        "fig9_phase_n": (["phase_n4", "phase_n8"],
+                         ("figures", "phase_n6", ["phase_n4", "phase_n8"], "phase_n",
+                          "fig9_phase_n")),
+        "phase_auto": (["phase_auto"], ("phase", "phase_auto")),
+        "phase_main": (["main_job"], ("phase", "main_job")),
+        "phase_n6": (["phase_n6"], ("phase", "phase_n6")),
+        "seed_cells": (["seed_cells"], ("summary", "seed_cells")),
+        "seed_distributions": (["seeds_n6", "seeds_auto"],
+                               ("figures", "seeds_n6", ["seeds_n6", "seeds_auto"], "seeds",
+                                "seed_distributions")),
+    }
+
+
+def needed_steps(names, table):
+    """The steps the figures ``names`` need: their own, and the main sweep ``loopsim
+    figures`` reads for them."""
+    need = set()
+    for name in names:
+        own, how = table[name]
+        need.update(own)
+        if how[0] == "figures":
+            need.add(how[1])
+        elif how[0] in ("phase", "summary"):
+            need.add(how[1])
+    return need
 
 
 def loopsim(args, dry_run, max_wall=None):
-    """Run ``python -m loopsim ARGS``; ``max_wall``: seconds after which a sweep gets
-    SIGTERM (it keeps its finished cases and exits 143; the figures use those)."""
+    """Run ``loopsim ARGS``: in this process (``loopsim.cli.main``), or, with ``max_wall``,
+    as ``python -m loopsim ARGS`` that gets SIGTERM after ``max_wall`` seconds (a sweep
+    keeps its finished cases and exits 143; the figures use those).  Returns the wall
+    time."""
     command = [sys.executable, "-m", "loopsim", *args]
-    print("$ " + " ".join(shlex.quote(a) for a in command)
+    print("$ " + " ".join(shlex.quote(a) for a in (command if max_wall else ["loopsim", *args]))
           + (f"    # capped at {max_wall:g} s" if max_wall else ""), flush=True)
     if dry_run:
-        return
+        return 0.0
     start = time.monotonic()
-    process = subprocess.Popen(command)
-    try:
-        code = process.wait(timeout=max_wall)
-    except subprocess.TimeoutExpired:
-        process.send_signal(signal.SIGTERM)
-        code = process.wait()
+    if max_wall is None:
+        from loopsim import cli
+
+        try:
+            code = cli.main(list(args))
+        except SystemExit as exc:  # argparse
+            code = exc.code if isinstance(exc.code, int) else 2
+    else:
+        process = subprocess.Popen(command)
+        try:
+            code = process.wait(timeout=max_wall)
+        except subprocess.TimeoutExpired:
+            process.send_signal(signal.SIGTERM)
+            code = process.wait()
     wall = time.monotonic() - start
     print(f"# wall {wall:.0f} s, exit status {code}", flush=True)
     if code == 1 and args[0] == "sweep":  # some case failed: it is a row with its status
@@ -177,6 +247,39 @@ def loopsim(args, dry_run, max_wall=None):
               flush=True)
     elif code != 0:
         sys.exit(f"make_figures: '{' '.join(args[:2])} ...' exited with status {code}")
+    return wall
+
+
+def draw(name, how, paths, out, work, quick):
+    """Draw figure ``name`` into ``out``/``name``.png; ``paths``: {step: its output}."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from loopsim import figures, plots, read_results
+
+    target = os.path.join(out, f"{name}.png")
+    kind = how[0]
+    if kind == "stability":
+        n = 6 if quick else 16
+        fig = figures.stability(*figures.stability_data(n=n, n_values=range(3, n + 1)))
+        plots.save(fig, target, dpi=DPI)
+    elif kind == "phase":
+        plots.save(plots.phase_diagram(read_results(paths[how[1]])), target, dpi=PHASE_DPI)
+    elif kind == "summary":
+        loopsim(["summary", paths[how[1]], "--figure", target], dry_run=False)
+    else:
+        _, main, others, figure, stem = how
+        staging = os.path.join(work, name)
+        shutil.rmtree(staging, ignore_errors=True)
+        written = figures.write_figures(paths[main], [paths[o] for o in others], staging,
+                                        only=[figure], stability_n=6 if quick else 16,
+                                        branch_n=6 if quick else 12, dpi=DPI, log=lambda _: None)
+        if stem not in written:
+            raise SystemExit(f"make_figures: {name}: loopsim figures drew {sorted(written)}, "
+                             f"not {stem}")
+        os.makedirs(out, exist_ok=True)
+        shutil.copyfile(written[stem], target)
+    print(f"{name}: {target}", flush=True)
 
 
 def main():
@@ -185,26 +288,56 @@ def main():
     parser.add_argument("--out", default=os.path.join("docs", "figures"))
     parser.add_argument("--threads", type=int, default=os.cpu_count() or 1)
     parser.add_argument("--max-wall", type=float, default=None, metavar="SECONDS",
-                        help="stop each resolved sweep (--n auto, and --n24) after this many "
-                             "seconds and draw from the cases it finished (default: no cap)")
+                        help="stop each --n auto sweep after this many seconds and draw from "
+                             "the cases it finished (default: no cap)")
+    parser.add_argument("--only", metavar="NAME[,NAME...]",
+                        help="draw these figures (PNG stems; see --list) and run what they need")
+    parser.add_argument("--list", action="store_true",
+                        help="print each figure with the steps it needs, and stop")
+    parser.add_argument("--quick", action="store_true",
+                        help="tiny inputs (3 x 3 grids, t = 0.5, n-max 8, 3 seeds): exercises "
+                             "every step and drawing in about a minute; not figures to commit")
     parser.add_argument("--n24", action="store_true",
                         help="also run the fixed n = 24 check (4 cases, not drawn)")
     parser.add_argument("--dry-run", action="store_true", help="print the commands only")
     args = parser.parse_args()
     if args.max_wall is not None and args.max_wall <= 0:
         parser.error("--max-wall must be positive")
+    table = targets(args.quick)
+    names = (sorted(table) if args.only is None
+             else [v.strip() for v in args.only.split(",") if v.strip()])
+    unknown = sorted(set(names) - set(table))
+    if unknown:
+        parser.error(f"unknown figure(s) {', '.join(unknown)}; "
+                     f"choose from {', '.join(sorted(table))}")
+    if args.quick and os.path.abspath(args.out) == os.path.abspath(os.path.join("docs", "figures")):
+        parser.error("--quick figures are not docs figures: give another --out")
+    all_steps = steps(args.runs, args.threads, args.quick, args.n24)
+    if args.list:
+        for name in sorted(table):
+            print(f"{name}: {', '.join(sorted(needed_steps([name], table))) or '(no run)'}")
+        return
     fig = os.path.join(args.runs, "fig")
     os.makedirs(fig, exist_ok=True)
-    resolved_cases(os.path.join(fig, "resolved_cases.csv"))
+    resolved_cases(os.path.join(fig, "resolved_cases.csv"), args.quick)
     n24_cases(os.path.join(fig, "n24_cases.csv"))
-    for output, command, capped in steps(args.runs, args.threads, args.n24):
-        # a sweep resumes by itself; a finished run file is kept
-        if command[0] == "run" and os.path.exists(output):
+    need = needed_steps(names, table) | ({"resolved_n24"} if args.n24 else set())
+    start = time.monotonic()
+    for step, (output, command, capped) in all_steps.items():
+        if step not in need:
+            continue
+        if command[0] == "run" and os.path.exists(output):  # a sweep resumes by itself
             print(f"# {output} exists, kept")
             continue
         loopsim(command, args.dry_run, args.max_wall if capped else None)
-    for command in figure_commands(args.runs, args.out):
-        loopsim(command, args.dry_run)
+    if args.dry_run:
+        return
+    paths = {step: output for step, (output, _, _) in all_steps.items()}
+    work = os.path.join(fig, "draw")
+    for name in names:
+        draw(name, table[name][1], paths, args.out, work, args.quick)
+    print(f"# {len(names)} figures in {args.out}, {time.monotonic() - start:.0f} s in all",
+          flush=True)
 
 
 if __name__ == "__main__":

@@ -2,8 +2,9 @@
 
 Usage: python scripts/plot_trajectory.py RUN.parquet FIGURE.png
 
-Left: the snapshots seen along x, centred on the centre of mass, coloured by
-time; right: tilt and aspect ratio against time (``loopsim.plots.trajectory``).
+Left: the snapshots seen face-on (projected on the last shape's principal plane),
+centred on the centre of mass, coloured by time with a colour bar; right: tilt and
+aspect ratio against time (``loopsim.plots.trajectory``).
 """
 import sys
 

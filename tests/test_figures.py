@@ -1,4 +1,4 @@
-"""Figures (loopsim/figures.py, ``loopsim figures``, scripts/plot_trajectory.py).
+"""Figures (loopsim/figures/, ``loopsim figures``, scripts/plot_trajectory.py, scripts/make_figures.py).
 
 Figure functions are drawn from small synthetic tables (tilted ellipses with known
 tilt and aspect ratio), so these tests need no integration; the command line and
@@ -101,6 +101,13 @@ def test_centred_curve_removes_only_the_mean():
 def test_gallery_draws_side_and_plane_views_in_regime_colours():
     frame = table()
     fig = figures.gallery(frame, theta0_deg=30.0)
+    # a colour key of the regimes drawn; titles name θ0 (initial) and the terminal tilt
+    key = [t.get_text() for t in fig.legends[0].get_texts()]
+    drawn_regimes = frame[frame["theta0_deg"] == 30.0]["regime"]
+    for regime in drawn_regimes:
+        assert plots.REGIME_STYLE[regime]["label"] in key
+    assert "θ0 = 30° (initial tilt)" in fig._suptitle.get_text()
+    assert "terminal θ" in fig.axes[0].get_title()
     cases = frame[frame["theta0_deg"] == 30.0]
     assert len(fig.axes) == 2 * len(cases)
     expected = [plots.REGIME_STYLE[r]["color"] for r in cases.sort_values("g0")["regime"]]
@@ -158,9 +165,28 @@ def test_phase_diagram_paper_band_adds_the_two_empirical_curves():
     assert np.allclose(g0 * np.sin(np.radians(theta)) / 3, plots.PAPER_BAND[1])
 
 
+def test_phase_diagram_draws_failed_cases_resolved_or_not():
+    frame = table().assign(resolved=False)
+    failed = [c for c in plots.phase_diagram(frame).axes[0].collections if c.get_label() == "failed"]
+    assert len(failed) == 1 and len(failed[0].get_offsets()) == (frame["regime"] == "failed").sum()
+
+
 def test_phase_diagrams_one_panel_per_sweep():
     fig = figures.phase_diagrams([table(), table(8)])
     assert len(fig.axes) == 2
+
+
+def test_phase_diagrams_share_one_legend_with_every_panels_markers():
+    """A marker drawn in one panel only (hollow: not resolved) has its legend entry."""
+    only_left = table().assign(resolved=False)
+    only_right = table().assign(resolved=True)
+    fig = figures.phase_diagrams([only_left, only_right])
+    left, right = fig.axes
+    assert left.get_legend() is None
+    labels = [t.get_text() for t in right.get_legend().get_texts()]
+    assert "stable, not resolved at n" in labels and "stable" in labels
+    assert len(labels) == len(set(labels))
+    assert labels.index("stable") < labels.index("stable, not resolved at n") < labels.index("in-plane")
 
 
 def test_q_and_tilt_scatter_and_thresholds():
@@ -233,6 +259,35 @@ def test_seed_distributions_one_histogram_per_table():
     fig = figures.seed_distributions([frame, frame], ["a", "b"])
     left, right = fig.axes
     assert len(left.patches) == 2 and len(right.patches) == 2
+    # one legend, below the panels (not over the bars); the title names g0 and θ0
+    assert left.get_legend() is None and right.get_legend() is None and len(fig.legends) == 1
+    title = fig._suptitle.get_text()
+    assert "g0 = 20" in title and "θ0 = 10°, 30°, 60°, 85°" in title
+
+
+def test_aspect_ratio_axes_say_what_the_ratio_is():
+    label = figures.aspect_ratio(table()).axes[0].get_ylabel()
+    assert "variance" in label and "major / minor principal axis" in label
+    assert "variance" in figures.seed_distributions([table(4)]).axes[1].get_xlabel()
+
+
+def test_evolution_rows_share_one_time_range_and_one_colour_bar():
+    """Several runs: one row each, coloured on one time scale (0 to the latest time any row
+    draws), one colour bar; rows titled by their runs."""
+    short = trajectory(times=np.linspace(0.0, 2.0, 5))  # settles at t = 1
+    long = trajectory(times=np.linspace(0.0, 4.0, 9)).assign(
+        theta_deg=lambda f: 30.0 - f["t"])  # still tilting at t = 4
+    fig = figures.evolution_rows([short, long], ["short", "long"])
+    assert len(fig.axes) == 2 * 3 + 1  # three views per row, one colour bar
+    colour_bars = [ax for ax in fig.axes if ax.get_ylabel() == "time t"]
+    assert len(colour_bars) == 1
+    assert colour_bars[0].get_ylim() == pytest.approx((0.0, 4.0))
+    assert [sub._suptitle.get_text() for sub in fig.subfigs[0].subfigs] == [
+        "short: t = 0 to 1", "long: t = 0 to 4"]
+    cmap, norm = figures.time_colours((0.0, 4.0))
+    side = [ax for ax in fig.axes if ax.get_title() == "side view (along x)"]
+    last_short = side[0].get_lines()[-1].get_color()
+    assert matplotlib.colors.to_hex(last_short) == matplotlib.colors.to_hex(cmap(norm(1.0)))
 
 
 # ---- real files: a tiny sweep, a tiny run -------------------------------------------
@@ -303,3 +358,28 @@ def test_undetermined_rows_are_ringed_in_the_phase_diagram_and_figs_7_8():
     assert tuple(rings[0].get_offsets()[0]) == (frame["theta0_deg"].iloc[0], frame["g0"].iloc[0])
     fig = figures.q_and_tilt(frame)
     assert any(c.get_label().startswith("not determined") for c in fig.axes[0].collections)
+
+
+# ---- scripts/make_figures.py ---------------------------------------------------------
+def test_make_figures_quick_draws_every_committed_figure(tmp_path):
+    """``scripts/make_figures.py --quick`` runs every step on tiny inputs and draws every
+    PNG of docs/figures/: the one command covers the committed figures."""
+    committed = sorted(name for name in os.listdir(os.path.join(ROOT, "docs", "figures"))
+                       if name.endswith(".png"))
+    out = tmp_path / "figures"
+    done = subprocess.run(
+        [sys.executable, os.path.join("scripts", "make_figures.py"), "--quick", "--threads", "1",
+         "--runs", str(tmp_path / "runs"), "--out", str(out)],
+        cwd=ROOT, capture_output=True, text=True, timeout=900)
+    assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
+    assert sorted(os.listdir(out)) == committed
+    for name in committed:
+        assert (out / name).stat().st_size > 5_000, name
+    assert f"{len(committed)} figures in {out}" in done.stdout
+
+
+def test_make_figures_quick_refuses_the_docs_folder():
+    done = subprocess.run(
+        [sys.executable, os.path.join("scripts", "make_figures.py"), "--quick", "--dry-run"],
+        cwd=ROOT, capture_output=True, text=True, timeout=120)
+    assert done.returncode == 2 and "not docs figures" in done.stderr

@@ -34,11 +34,13 @@ def check(result, benign):
 
 #: (label, g0, theta0, kwargs, expected status, expected regime, bound on the terminal
 #: |relative length error|): bounds about 10-100x what both methods reach (measured:
-#: very flexible 0.055-0.13 (transient 0.18), vertical 5.5e-6, horizontal 1.3e-11, high n
+#: very flexible 0.089 (transient 0.13, both methods: at t = 0.3 radau5's transient was
+#: 0.18 on one machine and 0.251, a LENGTH_ERROR stop, on an AMD EPYC: at n = 6 this case
+#: is so under-resolved that its length error follows the rounding), vertical 5.5e-6, horizontal 1.3e-11, high n
 #: 6e-8, near critical 9.1e-6, large perturbation 1.8e-6, no penalty 6.4e-9, large
 #: penalty 1.2e-10, early stop 1.3e-11, tiny budget 2.2e-5).
 FAST = [
-    ("very flexible", 1000.0, 45.0, dict(t_span=(0, 0.3)), "ok", "3d", 0.25),
+    ("very flexible", 1000.0, 45.0, dict(t_span=(0, 0.1)), "ok", "3d", 0.15),
     ("vertical", 100.0, 90.0, dict(t_span=(0, 1.0)), "ok", "3d", 1e-4),
     ("horizontal", 100.0, 0.0, dict(t_span=(0, 1.0)), "ok", "stable", 1e-9),
     ("high n", 60.0, 30.0, dict(n=16, t_span=(0, 0.05)), "ok", "stable", 1e-6),

@@ -27,9 +27,6 @@ PACKAGE = "loopsim"
 PRIVATE_MODULE_UNIT_TESTS = {"tests/test_jitcache.py": {"loopsim._jitcache"}}
 #: The most physical lines a module of the package may have (issue 23, "Layout").
 MAX_MODULE_LINES = 500
-#: Modules still over the limit while their split is under way elsewhere (path: where).
-#: An entry must be removed once its module is within the limit (the check says so).
-OVER_LIMIT_PENDING = {"loopsim/figures.py": "split into a package on branch split-figures"}
 
 
 # ---- reading the package ------------------------------------------------------------
@@ -206,22 +203,15 @@ def test_import_graph_has_no_cycles():
 
 def test_no_module_is_over_the_line_limit():
     """Every .py file of the package has at most MAX_MODULE_LINES physical lines (one job
-    per module), except the modules listed in OVER_LIMIT_PENDING, and those only while
-    they are still over it."""
-    over, settled = [], []
+    per module)."""
+    over = []
     for name, (path, _) in sorted(package_modules().items()):
         with open(path, encoding="utf-8") as handle:
             lines = sum(1 for _ in handle)
-        where = os.path.relpath(path, ROOT).replace(os.sep, "/")
-        if lines > MAX_MODULE_LINES and where not in OVER_LIMIT_PENDING:
-            over.append(f"  {where}: {lines} lines")
-        elif lines <= MAX_MODULE_LINES and where in OVER_LIMIT_PENDING:
-            settled.append(f"  {where}: {lines} lines (remove it from OVER_LIMIT_PENDING)")
-    missing = [f"  {where}: gone (remove it from OVER_LIMIT_PENDING)"
-               for where in OVER_LIMIT_PENDING if not os.path.exists(os.path.join(ROOT, where))]
+        if lines > MAX_MODULE_LINES:
+            over.append(f"  {os.path.relpath(path, ROOT)}: {lines} lines")
     assert not over, (f"modules over {MAX_MODULE_LINES} lines (split them by job):\n"
                       + "\n".join(over))
-    assert not settled + missing, "\n".join(settled + missing)
 
 
 def test_package_uses_no_private_names_of_other_modules():
@@ -233,9 +223,9 @@ def test_package_uses_no_private_names_of_other_modules():
     assert not offenders, "private names of other loopsim modules used:\n" + _format(offenders)
 
 
-@pytest.mark.parametrize("folder", ["tests", "scripts"])
+@pytest.mark.parametrize("folder", ["tests", "scripts", "benchmarks"])
 def test_clients_use_no_private_loopsim_names(folder):
-    """Tests and scripts use loopsim through its public names only."""
+    """Tests, scripts and benchmarks use loopsim through its public names only."""
     known = set(package_modules())
     directory = os.path.join(ROOT, folder)
     offenders = []

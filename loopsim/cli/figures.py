@@ -11,7 +11,7 @@ def add_parser(commands):
         "(stability, computed), from SWEEP_DIR Figs. 4, 5, 7, 8; from more sweep "
         "directories Fig. 9 (a grid at another n), seed distributions (several seeds of one "
         "point) or a reference overlay (any other); from run files (loopsim run --out) "
-        "Fig. 6 and the tension colouring (loopsim/figures.py).",
+        "Fig. 6 and the tension colouring (loopsim/figures/).",
         formatter_class=HelpFormatter,
     )
     figures.add_argument("sweep_dir", metavar="SWEEP_DIR", help="the main sweep directory")

@@ -29,7 +29,7 @@ On that grid the maps compose into one operator on the tension's grid values
 with P1 = S1 F and P2 = S2 F the projected first and second derivatives and ∘
 the elementwise product.  A = (B₂ + B B) S0 costs three (K, M) @ (M, M)
 products instead of two (M, M) @ (M, 3K + 3) ones, half the flops; measured
-1.4–2× faster per call at n = 16–64 (``scripts/bench_kernels.py``).  The
+1.4–2× faster per call at n = 16–64 (``benchmarks/bench_kernels.py``).  The
 column-block form (:func:`compose_maps`, :func:`loop_velocity_blocks`) stays
 for the Jacobian and as the reference the fast path is tested against.
 """

@@ -1,7 +1,7 @@
 """Scaling in n: cost per RHS evaluation and per trajectory, where the time goes,
 and whether the step is limited by stiffness or accuracy.
 
-Usage: python scripts/scaling.py [--orders 4,6,8,10,12,16] [--t-end 0.5]
+Usage: python benchmarks/scaling.py [--orders 4,6,8,10,12,16] [--t-end 0.5]
 
 For each n (in-plane case g0 = 60, θ0 = 30°):
 * µs per RHS evaluation, split into the maps (the affine map T -> ε of

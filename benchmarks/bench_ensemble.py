@@ -1,6 +1,6 @@
 """Ensemble benchmark: cases per second, parallel efficiency, early stopping, load balance.
 
-Usage: python scripts/bench_ensemble.py [--g0 10:350:8] [--theta0 6:90:8] [--n 6]
+Usage: python benchmarks/bench_ensemble.py [--g0 10:350:8] [--theta0 6:90:8] [--n 6]
 
 Runs the same paper-like grid (n = 6, t_end = 10) as full sweeps with 1 and
 2 threads, with and without early stopping, and prints cases per second,

@@ -1,8 +1,8 @@
 """Dask against the local backend: the same sweep on this machine's threads and on a LocalCluster.
 
-Usage: python scripts/bench_dask.py [--t-end 3] [--chunk-size 8] [--workers 2]
+Usage: python benchmarks/bench_dask.py [--t-end 3] [--chunk-size 8] [--workers 2]
 
-1. The 64-case grid of scripts/bench_ensemble.py (g0 = 10..350 x theta0 = 6..90 deg,
+1. The 64-case grid of benchmarks/bench_ensemble.py (g0 = 10..350 x theta0 = 6..90 deg,
    n = 6), once on the local backend (2 threads: a prange kernel when the README's
    table was measured, a work queue since), once on a LocalCluster of 2 worker
    processes x 1 Numba thread, with each worker writing its chunks (write="worker") and

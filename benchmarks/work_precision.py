@@ -1,6 +1,6 @@
 """Work-precision: error against wall time over rtol and n, for each integrator.
 
-Usage: python scripts/work_precision.py [--out runs/work_precision] [--quick]
+Usage: python benchmarks/work_precision.py [--out runs/work_precision] [--quick]
 
 Two cases:
 * in-plane: g0 = 60, θ0 = 30°, t = 10 (a steady elongated terminal shape);

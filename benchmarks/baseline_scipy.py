@@ -1,6 +1,6 @@
 """The baseline a user might write instead: plain NumPy maps + scipy's stiff solve_ivp.
 
-Usage: python scripts/baseline_scipy.py [--n 6] [--g0 60] [--theta0 30] [--t-end 10]
+Usage: python benchmarks/baseline_scipy.py [--n 6] [--g0 60] [--theta0 30] [--t-end 10]
 
 The same equations as loopsim (f = P_n[-x'''' + (T x')' - g0 e_z],
 u = P_n[f + (x'·f) x'], T minimising ∫ε², ε = x'·u' - w(1 - x'·x')), written
@@ -8,7 +8,7 @@ the direct way: dense NumPy arrays on the 4n + 1 point grid, the tension
 matrix built column by column, ``numpy.linalg.lstsq``, and
 ``scipy.integrate.solve_ivp`` with Radau or BDF (finite-difference Jacobian),
 and, as a careful user would, Radau with the exact chain-rule Jacobian in
-plain NumPy (``scripts/numpy_jacobian.py``).  Nothing else from
+plain NumPy (``benchmarks/numpy_jacobian.py``).  Nothing else from
 loopsim's numerics is used; the initial shape and the error measure come from
 loopsim so both start from the same state.
 

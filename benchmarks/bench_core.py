@@ -1,6 +1,6 @@
 """Core-solver benchmark: cost of one t = 10 trajectory against truncation order.
 
-Usage: python scripts/bench_core.py [--orders 4,6,8,12] [--g0 60] [--theta0 30]
+Usage: python benchmarks/bench_core.py [--orders 4,6,8,12] [--g0 60] [--theta0 30]
 
 For each n: steps, rejections, RHS evaluations, wall seconds after JIT
 warm-up (one core), µs per RHS evaluation, the mean step against the

@@ -1,6 +1,6 @@
 """Cost per call of the implicit integrator's kernels, by truncation order n.
 
-Usage: python scripts/bench_kernels.py [--orders 6,8,12,16,24,32,48,64] [--out FILE.json]
+Usage: python benchmarks/bench_kernels.py [--orders 6,8,12,16,24,32,48,64] [--out FILE.json]
 
 For each n, on one 3D shape (g0 = 150, θ0 = 45°, n = 12 run to t = 0.3,
 zero-padded to n: a loop in mid-transient), best of three timed loops each:

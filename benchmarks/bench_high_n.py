@@ -1,6 +1,6 @@
 """Wall time, work counts and terminal outcome of radau5 on the 3D cases of issue 11.
 
-Usage: python scripts/bench_high_n.py [--cases 100:60,150:45,150:80] [--orders 16,24]
+Usage: python benchmarks/bench_high_n.py [--cases 100:60,150:45,150:80] [--orders 16,24]
                                       [--t-end 10] [--rtol 1e-6] [--out FILE.json]
 
 For each case (g0:θ0) and order n it runs ``loopsim.simulate(method="radau5")``

@@ -1,6 +1,6 @@
 """The fast right-hand side against the previous dense path, whole trajectories, in one process.
 
-Usage: python scripts/bench_paths.py [--cases 100:60,150:45,150:80] [--orders 16,24,32]
+Usage: python benchmarks/bench_paths.py [--cases 100:60,150:45,150:80] [--orders 16,24,32]
                                      [--t-end 10] [--rtol 1e-6] [--repeats 2] [--out FILE.json]
 
 Both paths integrate the same start (``shapes.initial_shape``, perturbation 1e-3,
