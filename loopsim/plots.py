@@ -239,3 +239,13 @@ def tilt_distribution(cells, frame=None, ax=None):
     ax.set_title("terminal tilt over seeds", fontsize=10)
     ax.legend(fontsize=7, framealpha=0.9, loc="best")
     return fig
+
+
+def distribution_summary(cells, frame):
+    """Two panels from a summary table (``summary.summarize``) and its rows: P(3D) per
+    cell (:func:`probability_phase_diagram`) and the terminal tilt over the seeds
+    (:func:`tilt_distribution`)."""
+    fig, axes = plt.subplots(1, 2, figsize=(13.5, 4.2), constrained_layout=True)
+    probability_phase_diagram(cells, ax=axes[0])
+    tilt_distribution(cells, frame, ax=axes[1])
+    return fig

@@ -41,13 +41,8 @@ def command(args):
                                            summary_of=os.path.abspath(args.sweep_dir)), shown)
     if args.figure is not None:
         use_agg()
-        import matplotlib.pyplot as plt
-
         from .. import plots
 
-        fig, axes = plt.subplots(1, 2, figsize=(13.5, 4.2), constrained_layout=True)
-        plots.probability_phase_diagram(table, ax=axes[0])
-        plots.tilt_distribution(table, frame, ax=axes[1])
-        plots.save(fig, args.figure, dpi=150)
+        plots.save(plots.distribution_summary(table, frame), args.figure, dpi=150)
         print(f"figure: {args.figure}")
     return 0

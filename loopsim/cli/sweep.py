@@ -30,11 +30,19 @@ def add_parser(commands):
                       help="truncation orders, or auto: every case starts at n = "
                       f"{DEFAULT_N} and climbs (up to --n-max) whenever its spectral tail passes "
                       "--tail-tol")
-    grid.add_argument("--seeds", type=int, default=1, metavar="K", help="seeds 0..K-1 per point")
+    grid.add_argument("--seeds", default="1", metavar="K|auto",
+                      help="seeds 0..K-1 per point, or auto: per point 4, 8, 16 ... seeds "
+                      "until its answer is sharp (see --p-halfwidth; docs/distributions.md)")
     grid.add_argument("--cases", metavar="FILE", help="CSV/Parquet with columns g0, theta0_deg "
                       "[, n, seed, perturbation, initial, initial_case_id] instead of a grid "
                       "(initial: a point file or results per row, paths relative to FILE; "
                       "theta0_deg then left empty)")
+    sharp = sweep.add_argument_group(
+        "--seeds auto: seeds added per point until it is deterministic (every seed in one "
+        "regime, tilts within 0.05 deg), sharp (both targets met) or at --max-seeds")
+    for flag, metavar, default, text in SEED_TARGETS:
+        sharp.add_argument(flag, type=real if metavar != "K" else int, default=None,
+                           metavar=metavar, help=f"{text} (default: {default})")
     add_integration_options(sweep)
     sweep.add_argument("--no-early-stop", action="store_true",
                        help="always integrate to --t-end (default: stop once the shape and tilt "
@@ -76,6 +84,17 @@ def add_parser(commands):
     return sweep
 
 
+#: --seeds auto's targets: flag, metavar, default (seeding.SeedTargets), help.
+SEED_TARGETS = (
+    ("--p-halfwidth", "P", 0.15, "largest half-width of each regime probability's 95%% "
+     "Wilson interval"),
+    ("--tilt-halfwidth", "DEG", 2.5, "largest half-width of the median terminal tilt's 95%% "
+     "bootstrap interval"),
+    ("--min-seeds", "K", 4, "seeds of the first round"),
+    ("--max-seeds", "K", 64, "seeds at most per point"),
+)
+SEED_TARGET_FIELDS = dict(p_halfwidth="p_halfwidth", tilt_halfwidth="tilt_halfwidth_deg",
+                          min_seeds="min_seeds", max_seeds="max_seeds")
 RERUN_OPTIONS = ("method", "rtol", "atol")  # what --rerun-failed takes from the command line
 
 
@@ -103,17 +122,16 @@ def _sweep_config(args, sweeps):
     else:
         if not (args.g0 and args.theta0):
             raise ValueError("a sweep needs --g0 and --theta0 (or --cases FILE)")
-        if args.seeds < 1:
-            raise ValueError(f"--seeds must be >= 1, got {args.seeds}")
+        seeds = 1 if args.seeds == "auto" else args.seeds
         axes = (sweeps.parse_values(args.g0, "--g0"),
                 sweeps.parse_values(args.theta0, "--theta0"),
                 [DEFAULT_N] if args.n == "auto"
                 else sweeps.parse_values(args.n, "--n", integer=True))
-        count = math.prod(len(axis) for axis in axes) * args.seeds
+        count = math.prod(len(axis) for axis in axes) * seeds
         if count > validation.MAX_CASES:
             raise ValueError(f"the grid has {count} cases (--g0 x --theta0 x --n x --seeds), "
                              f"more than a sweep's {validation.MAX_CASES}: split it")
-        cases = sweeps.grid_cases(*axes, args.seeds, args.perturbation)
+        cases = sweeps.grid_cases(*axes, seeds, args.perturbation)
     return sweeps.SweepConfig(cases=cases, t_end=args.t_end, rtol=args.rtol, atol=args.atol,
                               w=args.w, method=args.method or (
                                   "auto" if args.n == "auto" else "rkf45"),
@@ -129,6 +147,35 @@ def _sweep_config(args, sweeps):
                               n_max=args.n_max, tail_tol=args.tail_tol)
 
 
+def _parse_seeds(args):
+    """``--seeds K|auto`` into an int or "auto", and the --seeds auto targets
+    (``seeding.SeedTargets``, or None), each refused where it does not apply."""
+    from .. import seeding
+
+    if args.seeds != "auto":
+        try:
+            args.seeds = int(args.seeds)
+        except ValueError:
+            raise ValueError(f"--seeds must be a count K >= 1 or auto, got {args.seeds!r}") \
+                from None
+        if args.seeds < 1:
+            raise ValueError(f"--seeds must be >= 1, got {args.seeds}")
+    given = {field: getattr(args, name) for name, field in SEED_TARGET_FIELDS.items()
+             if getattr(args, name) is not None}
+    if args.seeds != "auto":
+        if given:
+            name = next(k for k, v in SEED_TARGET_FIELDS.items() if v in given)
+            raise ValueError(f"--{name.replace('_', '-')} applies only with --seeds auto")
+        return None
+    for flag, value in (("--cases", args.cases), ("--shard", args.shard),
+                        ("--snapshots-for", args.snapshots_for or None),
+                        ("--rerun-failed", args.rerun_failed)):
+        if value is not None:
+            raise ValueError(f"{flag} does not apply with --seeds auto (its rounds are planned "
+                             "from the grid's points as the seeds come in)")
+    return seeding.SeedTargets(**given).check()
+
+
 def _check_rerun_options(args):
     """With --rerun-failed the cases and settings come from DIR: refuse the options that
     would be ignored (given with a value other than their default)."""
@@ -137,7 +184,8 @@ def _check_rerun_options(args):
     defaults = vars(parser.parse_args(["sweep"]))
     ignored = [key for key in ("g0", "theta0", "cases", "n", "seeds", "t_end", "w", "perturbation",
                                "no_early_stop", "snapshots_for", "snapshots", "chunk_size",
-                               "shard", "out", "n_max", "tail_tol", "no_twin")
+                               "shard", "out", "n_max", "tail_tol", "no_twin", "p_halfwidth",
+                               "tilt_halfwidth", "min_seeds", "max_seeds")
                if getattr(args, key) != defaults[key]]
     if ignored:
         raise ValueError(f"--{ignored[0].replace('_', '-')} does not apply with --rerun-failed "
@@ -181,9 +229,18 @@ def command(args):
             if args.out is None:
                 raise ValueError("a sweep needs --out DIR (or --rerun-failed DIR)")
             out = validation.check_output_directory("--out", args.out)
+            targets = _parse_seeds(args)
             config = _sweep_config(args, sweeps)
-            frame = sweeps.run_sweep(config, out, shard=None if args.shard is None
-                                     else _parse_shard(args.shard), **backend)
+            if targets is None:
+                frame = sweeps.run_sweep(config, out, shard=None if args.shard is None
+                                         else _parse_shard(args.shard), **backend)
+            else:
+                frame, stops = sweeps.run_seeds_auto(
+                    config, out, targets, command_line=sys.argv,
+                    run_round=lambda round_config, directory: sweeps.run_sweep(
+                        round_config, directory, **backend),
+                    announce=None if args.quiet else lambda line: print(
+                        line, file=sys.stderr, flush=True))
     except KeyboardInterrupt as stopped:  # sweeps.SweepInterrupted, or a Ctrl-C before it
         done = (f"{stopped.done} of {stopped.total} cases done and kept in {stopped.out}; "
                 if hasattr(stopped, "done") else "")
@@ -209,10 +266,23 @@ def command(args):
               "is a sample of an ill-conditioned transient, not an outcome (regimes among "
               "them: " + ", ".join(f"{k} {v}" for k, v in
                                    sorted(undetermined["regime"].value_counts().items())) + ")")
+    seeds_auto = args.rerun_failed is None and args.seeds == "auto"
+    if seeds_auto:
+        reasons = stops["stop_reason"].value_counts().to_dict()
+        print(f"{len(stops)} points, seeds until sharp: " + ", ".join(
+            f"{k} {v}" for k, v in sorted(reasons.items()))
+            + f" (seeds per point {stops['seeds'].min()}-{stops['seeds'].max()}; why each "
+            f"stopped: {out}/seeds_auto.parquet; per point: loopsim summary {out})")
     if args.figure:
         use_agg()
-        plots.save(plots.phase_diagram(frame), args.figure)
-        print(f"phase diagram: {args.figure}")
+        if seeds_auto:
+            from .. import summary
+
+            plots.save(plots.distribution_summary(summary.summarize(frame), frame),
+                       args.figure, dpi=150)
+        else:
+            plots.save(plots.phase_diagram(frame), args.figure)
+        print(f"{'distribution summary' if seeds_auto else 'phase diagram'}: {args.figure}")
     failed = int((frame["status"] != "ok").sum())
     if failed:
         print(f"{failed} of {len(frame)} cases failed (column 'status'); exit status "

@@ -9,8 +9,9 @@ re-exported here (``loopsim.io.read_results`` and so on):
 
 * ``integrity``: atomic writes, temporaries, content hashes, the checked reader;
 * ``tables``: schemas, provenance, trajectory tables, a file's metadata;
-* ``sweepdir``: the sweep directory's layout and files, ``read_results``,
-  ``read_snapshots``.
+* ``sweepdir``: the sweep directory's layout and files, ``read_snapshots``;
+* ``seedsdir``: the ``--seeds auto`` directory (rounds of sweeps), and ``read_results``,
+  which reads either kind.
 """
 from .integrity import (
     CONTENT_KEY, DamagedFile, content_hash, read_table_checked, remove_stale_temporaries,
@@ -19,8 +20,12 @@ from .integrity import (
 from .sweepdir import (
     CHUNK_PATTERN, FINGERPRINT_IGNORES, LAYOUT, QUARANTINE_DIR, RERUN_DIR, SNAPSHOT_DIR,
     SWEEP_FILE, case_order, check_files_belong, check_layout, check_no_overlap, check_rows,
-    chunk_files, config_fingerprint, damaged_files, overlapping, quarantine, read_results,
-    read_snapshots, read_sweep_file, requires_hash, result_table,
+    chunk_files, config_fingerprint, damaged_files, overlapping, quarantine, read_snapshots,
+    read_sweep_file, requires_hash, result_table,
+)
+from .seedsdir import (
+    ROUND_DIR, SEEDS_FILE, STOPS_FILE, is_seeds_auto, read_results, read_seeds_auto,
+    read_seeds_file, read_stop_table, round_directory,
 )
 from .tables import (
     COEFFICIENT_LAYOUT, INPUT_FIELDS, OUTCOME_FIELDS, RESULT_SCHEMA, RUN_FIELDS, SUMMARY_FIELDS,
@@ -36,5 +41,7 @@ __all__ = [
     "overlapping", "provenance", "quarantine", "read_metadata", "read_results",
     "read_snapshots", "read_sweep_file", "read_table_checked", "remove_stale_temporaries",
     "requires_hash", "result_table", "trajectory_table", "write_json_atomically",
+    "ROUND_DIR", "SEEDS_FILE", "STOPS_FILE", "is_seeds_auto", "read_seeds_auto",
+    "read_seeds_file", "read_stop_table", "round_directory",
     "write_table_atomically", "write_trajectory",
 ]

@@ -23,7 +23,9 @@ One module per job, each layer importing only those above it:
 * ``stopping``: SIGINT / SIGTERM as a stop flag (:class:`SweepInterrupted`);
 * ``local``, ``dask_backend``: the backends (a work queue of threads, Dask tasks);
 * ``orchestrate``: :func:`run_sweep` and :func:`sweep`, the top level;
-* ``rerun``: reruns of the failed cases (:func:`rerun_failed`).
+* ``rerun``: reruns of the failed cases (:func:`rerun_failed`);
+* ``seeds_auto``: ``--seeds auto``, rounds of sweeps until each cell is sharp
+  (:func:`run_seeds_auto`).
 
 This package's names are the public API of sweeps; ``loopsim.ensemble``, their
 earlier home, re-exports them unchanged.
@@ -39,14 +41,15 @@ from .orchestrate import run_sweep, sweep
 from .progress import AUTO_COST_EXPONENT, Progress, case_weight
 from .rerun import config_from_dict, rerun_failed
 from .runner import case_ladder, case_method, run_chunk, run_piece
+from .seeds_auto import run_seeds_auto
 from .stopping import SweepInterrupted, in_background, stop_event, stop_on_signals
 
 __all__ = [
-    "AUTO_COST_EXPONENT", "CASE_COLUMNS", "CASE_OVERRIDES", "FIELD_NOTES", "REGIMES",
-    "Progress", "SweepConfig", "SweepInterrupted", "Thresholds", "canonical_chunks",
-    "case_ladder", "case_method", "case_option", "case_order", "case_weight", "chunk_case_ids",
-    "classify", "config_from_dict", "grid_cases", "in_background", "parse_values",
-    "pending_pieces", "read_cases_file", "repair_directory", "rerun_failed", "run_chunk",
-    "run_piece", "run_sweep", "stop_event", "stop_on_signals", "sweep", "validate",
-    "write_piece",
+    "AUTO_COST_EXPONENT", "CASE_COLUMNS", "CASE_OVERRIDES", "FIELD_NOTES", "Progress",
+    "REGIMES", "SweepConfig", "SweepInterrupted", "Thresholds", "canonical_chunks",
+    "case_ladder", "case_method", "case_option", "case_order", "case_weight",
+    "chunk_case_ids", "classify", "config_from_dict", "grid_cases", "in_background",
+    "parse_values", "pending_pieces", "read_cases_file", "repair_directory", "rerun_failed",
+    "run_chunk", "run_piece", "run_seeds_auto", "run_sweep", "stop_event",
+    "stop_on_signals", "sweep", "validate", "write_piece",
 ]

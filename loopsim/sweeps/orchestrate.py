@@ -5,7 +5,7 @@ import os
 
 import numpy as np
 
-from .. import io, validation
+from .. import io, seeding, validation
 from ..config import DEFAULT_AUTO_CHUNK_SIZE, DEFAULT_CHUNK_SIZE, DEFAULT_N, DEFAULT_PERTURBATION
 from .cases import SweepConfig, grid_cases, validate
 from .chunks import canonical_chunks, covered_ids, pending_pieces
@@ -13,6 +13,7 @@ from .dask_backend import close_cluster, dask_client, run_dask
 from .directory import prepare_directory
 from .local import run_local
 from .progress import Progress, case_weight
+from .seeds_auto import run_seeds_auto
 from .stopping import SweepInterrupted, stop_event, stop_on_signals
 
 
@@ -89,6 +90,11 @@ def run_sweep(config, out, threads=None, quiet=False, command_line=None, *, sche
     return io.read_results(out)
 
 
+#: ``sweep(seeds="auto")``'s keywords: the targets of ``seeding.SeedTargets``.
+SEED_TARGET_OPTIONS = dict(p_halfwidth="p_halfwidth", tilt_halfwidth="tilt_halfwidth_deg",
+                           min_seeds="min_seeds", max_seeds="max_seeds")
+
+
 def sweep(g0, theta0_deg, out, *, n=6, seeds=1, method=None, quiet=True, threads=None,
           scheduler=None, local_cluster=False, workers=None, **options):
     """The Python form of ``loopsim sweep``: every (g0, θ0, seed) of the grid into the
@@ -96,9 +102,13 @@ def sweep(g0, theta0_deg, out, *, n=6, seeds=1, method=None, quiet=True, threads
     (:func:`io.read_results`).
 
     ``g0`` and ``theta0_deg``: values (numbers or sequences); ``n``: an order, a
-    sequence of orders, or "auto"; ``seeds``: seeds 0..seeds-1 per point; ``method``:
-    as in ``simulate`` (default rkf45 at a fixed n, auto with ``n="auto"``).  Every
-    other keyword is a :class:`SweepConfig` field under its own name (``t_end``,
+    sequence of orders, or "auto"; ``seeds``: seeds 0..seeds-1 per point, or "auto":
+    seeds added per cell until its answer is sharp (``--seeds auto``: rounds of sweeps,
+    ``sweeps.seeds_auto``; its targets ``p_halfwidth``, ``tilt_halfwidth`` (deg),
+    ``min_seeds``, ``max_seeds`` as keywords, defaults of ``seeding.SeedTargets``; the
+    rows get a ``round`` column; the stop table: ``io.read_stop_table(out)``);
+    ``method``: as in ``simulate`` (default rkf45 at a fixed n, auto with ``n="auto"``).
+    Every other keyword is a :class:`SweepConfig` field under its own name (``t_end``,
     ``rtol``, ``atol``, ``w``, ``early_stop``, ``twin``, ``n_max``, ``tail_tol``,
     ``chunk_size``, ...) or ``perturbation``.  Backends as :func:`run_sweep`.  The
     directory is the one the command line writes: either may resume the other.
@@ -106,17 +116,31 @@ def sweep(g0, theta0_deg, out, *, n=6, seeds=1, method=None, quiet=True, threads
     auto = isinstance(n, str)
     if auto and n != "auto":
         raise ValueError(f"n must be an order, a sequence of orders or 'auto', got {n!r}")
+    seeds_auto = isinstance(seeds, str)
+    if seeds_auto and seeds != "auto":
+        raise ValueError(f"seeds must be a count or 'auto', got {seeds!r}")
+    targets = {SEED_TARGET_OPTIONS[k]: options.pop(k) for k in list(options)
+               if k in SEED_TARGET_OPTIONS}
+    if targets and not seeds_auto:
+        raise ValueError(f"{sorted(targets)} apply only with seeds='auto'")
     perturbation = options.pop("perturbation", DEFAULT_PERTURBATION)
     unknown = set(options) - {f.name for f in dataclasses.fields(SweepConfig)} - {"cases"}
     if unknown or "cases" in options:
         raise ValueError(f"unknown sweep option(s) {sorted(unknown or {'cases'})}")
     axes = [np.atleast_1d(np.asarray(v, dtype=float)).tolist() for v in (g0, theta0_deg)]
     orders = [DEFAULT_N] if auto else [int(v) for v in np.atleast_1d(n)]
-    seeds = validation.check_integer("seeds", seeds, 1)
+    seeds = 1 if seeds_auto else validation.check_integer("seeds", seeds, 1)
     cases = grid_cases(axes[0], axes[1], orders, seeds, perturbation)
     options.setdefault("chunk_size", DEFAULT_AUTO_CHUNK_SIZE if auto else DEFAULT_CHUNK_SIZE)
     config = SweepConfig(cases=cases, method=method or ("auto" if auto else "rkf45"),
                          n_auto=auto, **options)
-    return run_sweep(config, os.fspath(out), threads=threads, quiet=quiet,
-                     command_line=["loopsim.sweep(...)"], scheduler=scheduler,
-                     local_cluster=local_cluster, workers=workers)
+    backend = dict(threads=threads, quiet=quiet, command_line=["loopsim.sweep(...)"],
+                   scheduler=scheduler, local_cluster=local_cluster, workers=workers)
+    if seeds_auto:
+        rows, _ = run_seeds_auto(
+            config, os.fspath(out), seeding.SeedTargets(**targets),
+            run_round=lambda round_config, directory: run_sweep(round_config, directory,
+                                                                **backend),
+            command_line=backend["command_line"])
+        return rows
+    return run_sweep(config, os.fspath(out), **backend)
