@@ -73,6 +73,23 @@ def test_configuration_stored_once_fingerprint_in_each_file(reference):
     assert io.config_fingerprint(dict(stored["config"], t_end=0.4)) != stored["fingerprint"]
 
 
+def test_the_tables_metadata_describes_the_whole_table(reference):
+    """attrs hold what every file shares, the number of files and the range of creation
+    times, never one file's positions, content hash or creation time."""
+    out, frame = reference
+    meta = frame.attrs["loopsim"]
+    files = [io.read_metadata(path) for path in io.chunk_files(out).values()]
+    assert meta["files"] == len(files) == 3
+    assert not {"positions", io.CONTENT_KEY, "created_utc"} & set(meta)
+    created = sorted(m["created_utc"] for m in files)
+    assert (meta["created_utc_first"], meta["created_utc_last"]) == (created[0], created[-1])
+    assert meta["sweep_fingerprint"] == files[0]["sweep_fingerprint"]
+    assert meta["loopsim_version"] == loopsim.__version__
+    # a value the files disagree on is listed, not taken from the first file
+    mixed = io.table_metadata([dict(files[0], loopsim_version="0.1"), files[1]])
+    assert mixed["loopsim_version"] == sorted(["0.1", files[1]["loopsim_version"]])
+
+
 def test_files_follow_the_umask(tmp_path):
     previous = os.umask(0o002)
     try:

@@ -21,7 +21,7 @@ from .sweepdir import (
     CHUNK_PATTERN, FINGERPRINT_IGNORES, LAYOUT, QUARANTINE_DIR, RERUN_DIR, SNAPSHOT_DIR,
     SWEEP_FILE, case_order, check_files_belong, check_layout, check_no_overlap, check_rows,
     chunk_files, config_fingerprint, damaged_files, overlapping, quarantine, read_snapshots,
-    read_sweep_file, requires_hash, result_table,
+    read_sweep_file, requires_hash, result_table, table_metadata,
 )
 from .seedsdir import (
     ROUND_DIR, SEEDS_FILE, STOPS_FILE, is_seeds_auto, read_results, read_seeds_auto,
@@ -40,7 +40,7 @@ __all__ = [
     "coefficients", "config_fingerprint", "content_hash", "damaged_files", "described",
     "overlapping", "provenance", "quarantine", "read_metadata", "read_results",
     "read_snapshots", "read_sweep_file", "read_table_checked", "remove_stale_temporaries",
-    "requires_hash", "result_table", "trajectory_table", "write_json_atomically",
+    "requires_hash", "result_table", "table_metadata", "trajectory_table", "write_json_atomically",
     "ROUND_DIR", "SEEDS_FILE", "STOPS_FILE", "is_seeds_auto", "read_seeds_auto",
     "read_seeds_file", "read_stop_table", "round_directory",
     "write_table_atomically", "write_trajectory",

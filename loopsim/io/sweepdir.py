@@ -224,6 +224,29 @@ def damaged_files(out, files, stored):
     return found
 
 
+#: Metadata that describes one file, not the table its rows join (:func:`table_metadata`).
+PER_FILE_KEYS = ("positions", CONTENT_KEY, "created_utc")
+
+
+def table_metadata(files_meta):
+    """The metadata of a table joined from files with metadata ``files_meta`` (a list of
+    dicts, in file order): what every file shares; for a key whose value differs between
+    files (say, loopsim_version after a resume with another release), the sorted distinct
+    values; instead of each file's positions, content hash and creation time, the number of
+    files and the first and last creation times."""
+    meta = {}
+    for key in dict.fromkeys(k for m in files_meta for k in m):
+        if key in PER_FILE_KEYS:
+            continue
+        values = [m[key] for m in files_meta if key in m]
+        distinct = sorted({json.dumps(v, sort_keys=True) for v in values})
+        meta[key] = values[0] if len(distinct) == 1 else [json.loads(v) for v in distinct]
+    created = sorted(m["created_utc"] for m in files_meta if "created_utc" in m)
+    meta.update(files=len(files_meta), created_utc_first=created[0] if created else None,
+                created_utc_last=created[-1] if created else None)
+    return meta
+
+
 def read_results(out):
     """All finished cases of a sweep directory as a DataFrame sorted by case_id.
 
@@ -267,7 +290,7 @@ def read_results(out):
         raise ValueError(f"{out!r} holds case_id {int(duplicated.iloc[0])} more than once "
                          f"({len(duplicated)} duplicate rows): a chunk file was copied or "
                          "renamed; move the extra files away")
-    meta = read_metadata(paths[0])
+    meta = table_metadata([read_metadata(path) for path in paths])
     meta.update(sweep_config=stored["config"], thresholds=stored["config"].get("thresholds"),
                 command_line=stored.get("command_line", []),
                 field_notes=stored.get("field_notes", {}), reruns=stored.get("reruns", []),
