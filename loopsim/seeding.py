@@ -37,8 +37,8 @@ class SeedTargets:
     tilt_halfwidth_deg: float = 2.5
     min_seeds: int = 4
     max_seeds: int = 64
-    tilt_tol_deg: float = 0.05
-    aspect_tol: float = 1e-3
+    tilt_tol_deg: float = 1.0
+    aspect_tol: float = 0.1
 
     def check(self):
         """A one-line ValueError naming the first bad target."""

@@ -39,7 +39,8 @@ def add_parser(commands):
                       "theta0_deg then left empty)")
     sharp = sweep.add_argument_group(
         "--seeds auto: seeds added per point until it is deterministic (every seed in one "
-        "regime, tilts within 0.05 deg), sharp (both targets met) or at --max-seeds")
+        "regime, tilts within 1 deg, aspect ratios within 0.1), sharp (both targets met) or at "
+        "--max-seeds")
     for flag, metavar, default, text in SEED_TARGETS:
         sharp.add_argument(flag, type=real if metavar != "K" else int, default=None,
                            metavar=metavar, help=f"{text} (default: {default})")
