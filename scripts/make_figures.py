@@ -37,6 +37,10 @@ The steps (the runs), with the figures that need them:
   phase_auto, fig7_q_tilt_phase_auto, fig8_aspect_phase_auto.  Hours on 2 cores.  The
   committed ones were computed with the earlier ``--n auto`` (docs/earlier-n-auto.md);
   a rerun draws today's, whose numbers differ from that page's;
+* ``seeds_auto_study``: docs/distributions.md's study, ``--seeds auto`` (at most 32) at
+  ``--n auto`` with twins over g0 = 30, 60, 100 x θ0 = 30, 60°: seeds_auto_study
+  (``loopsim summary --figure``; ``scripts/distribution_study.py`` runs the same sweep
+  and its stricter-tolerance check);
 * ``seed_cells``: docs/distributions.md's four cells (g0 = 100, 150 x θ0 = 45, 60°),
   16 seeds each at ``--n auto`` with twins: seed_cells (``loopsim summary --figure``);
 * ``resolved_n24`` (only with --n24): 4 cases at fixed n = 24 (radau5, rtol 1e-7), a
@@ -153,6 +157,8 @@ def steps(runs, threads, quick=False, n24=False):
               "--n", "auto", *auto_quick, capped=True),
         sweep("phase_auto", *grid, "--n", "auto", "--method", "auto", *auto_quick, *lean,
               capped=True),
+        sweep("seeds_auto_study", "--g0", "30,60,100", "--theta0", "30,60", "--seeds", "auto",
+              "--max-seeds", "4" if quick else "32", "--n", "auto", *auto_quick, capped=True),
     ])
     out["main_job"] = out.pop("phase")  # the README's --out runs/phase, under a clearer name
     if n24:
@@ -193,6 +199,7 @@ def targets(quick=False):
         "phase_main": (["main_job"], ("phase", "main_job")),
         "phase_n6": (["phase_n6"], ("phase", "phase_n6")),
         "seed_cells": (["seed_cells"], ("summary", "seed_cells")),
+        "seeds_auto_study": (["seeds_auto_study"], ("summary", "seeds_auto_study")),
         "seed_distributions": (["seeds_n6", "seeds_auto"],
                                ("figures", "seeds_n6", ["seeds_n6", "seeds_auto"], "seeds",
                                 "seed_distributions")),
