@@ -87,3 +87,12 @@ DEFORMATION_FLOOR = 1e-3
 AUTO_ORDERS = (6, 8, 12, 16, 20, 24, 32, 40, 48, 64)
 DEFAULT_N_MAX = 32
 DEFAULT_TAIL_TOL = RESOLVED_TAIL
+#: ``--seeds auto``'s targets, by option name (``--p-halfwidth``, ``sweep(p_halfwidth=)``):
+#: (``seeding.SeedTargets`` field, default).  The defaults are defended in
+#: docs/distributions.md, "Seeds until the answer is sharp".
+SEED_TARGETS = {
+    "p_halfwidth": ("p_halfwidth", 0.15),
+    "tilt_halfwidth": ("tilt_halfwidth_deg", 2.5),
+    "min_seeds": ("min_seeds", 4),
+    "max_seeds": ("max_seeds", 64),
+}

@@ -21,6 +21,7 @@ import math
 
 import numpy as np
 
+from .config import SEED_TARGETS
 from .outcomes import REGIMES
 from .summary import bootstrap_interval, wilson_interval
 
@@ -33,10 +34,10 @@ class SeedTargets:
     """The targets of ``--seeds auto`` (defaults: docs/distributions.md, "Seeds until the
     answer is sharp")."""
 
-    p_halfwidth: float = 0.15
-    tilt_halfwidth_deg: float = 2.5
-    min_seeds: int = 4
-    max_seeds: int = 64
+    p_halfwidth: float = SEED_TARGETS["p_halfwidth"][1]
+    tilt_halfwidth_deg: float = SEED_TARGETS["tilt_halfwidth"][1]
+    min_seeds: int = SEED_TARGETS["min_seeds"][1]
+    max_seeds: int = SEED_TARGETS["max_seeds"][1]
     tilt_tol_deg: float = 1.0
     aspect_tol: float = 0.1
 

@@ -99,13 +99,27 @@ def test_the_python_sweep_runs_seeds_auto_and_refuses_targets_without_it(tmp_pat
         loopsim.sweep([10.0], [30.0], tmp_path / "bad", n=4, seeds="many", **FAST)
 
 
-def test_the_command_line_defaults_are_the_rules(tmp_path):
-    from loopsim.cli import sweep as sweep_command
+def test_every_target_is_an_option_of_the_command_line_and_of_sweep(tmp_path):
+    """Each of config.SEED_TARGETS reaches seeding.SeedTargets from --OPTION and from
+    sweep(OPTION=): a target given both ways is stored in the directory's record."""
+    import json
 
-    defaults = seeding.SeedTargets()
-    for flag, _, default, _ in sweep_command.SEED_TARGETS:
-        field = sweep_command.SEED_TARGET_FIELDS[flag[2:].replace("-", "_")]
-        assert getattr(defaults, field) == default, flag
+    from loopsim.cli import main
+    from loopsim.config import SEED_TARGETS
+
+    given = dict(p_halfwidth=0.3, tilt_halfwidth=7.5, min_seeds=2, max_seeds=2)
+    for how in ("cli", "python"):
+        out = tmp_path / how
+        if how == "cli":
+            flags = [x for k, v in given.items() for x in ("--" + k.replace("_", "-"), str(v))]
+            assert main(["sweep", "--g0", "10", "--theta0", "30", "--n", "4", "--t-end", "0.3",
+                         "--no-twin", "--seeds", "auto", "--threads", "1", "--quiet",
+                         "--out", str(out), *flags]) == 0
+        else:
+            loopsim.sweep([10.0], [30.0], out, n=4, seeds="auto", threads=1, **given, **FAST)
+        stored = json.loads((out / io.SEEDS_FILE).read_text())["targets"]
+        assert {SEED_TARGETS[k][0]: stored[SEED_TARGETS[k][0]] for k in given} == {
+            SEED_TARGETS[k][0]: v for k, v in given.items()}, how
 
 
 def test_seeds_auto_from_the_command_line(tmp_path, capsys):

@@ -3,7 +3,7 @@ when re-run; also reruns of a sweep's failed cases (``--rerun-failed``)."""
 import math
 import sys
 
-from ..config import DEFAULT_AUTO_CHUNK_SIZE, DEFAULT_CHUNK_SIZE, DEFAULT_N
+from ..config import DEFAULT_AUTO_CHUNK_SIZE, DEFAULT_CHUNK_SIZE, DEFAULT_N, SEED_TARGETS
 from .common import (
     EXIT_FAILED_RUN, HelpFormatter, Parser, add_integration_options, check_auto_options,
     interrupted, real, use_agg,
@@ -41,9 +41,10 @@ def add_parser(commands):
         "--seeds auto: seeds added per point until it is deterministic (every seed in one "
         "regime, tilts within 1 deg, aspect ratios within 0.1), sharp (both targets met) or at "
         "--max-seeds")
-    for flag, metavar, default, text in SEED_TARGETS:
-        sharp.add_argument(flag, type=real if metavar != "K" else int, default=None,
-                           metavar=metavar, help=f"{text} (default: {default})")
+    for name, (metavar, text) in SEED_TARGET_HELP.items():
+        sharp.add_argument("--" + name.replace("_", "-"), type=real if metavar != "K" else int,
+                           default=None, metavar=metavar,
+                           help=f"{text} (default: {SEED_TARGETS[name][1]})")
     add_integration_options(sweep)
     sweep.add_argument("--no-early-stop", action="store_true",
                        help="always integrate to --t-end (default: stop once the shape and tilt "
@@ -85,17 +86,15 @@ def add_parser(commands):
     return sweep
 
 
-#: --seeds auto's targets: flag, metavar, default (seeding.SeedTargets), help.
-SEED_TARGETS = (
-    ("--p-halfwidth", "P", 0.15, "largest half-width of each regime probability's 95%% "
-     "Wilson interval"),
-    ("--tilt-halfwidth", "DEG", 2.5, "largest half-width of the median terminal tilt's 95%% "
-     "bootstrap interval"),
-    ("--min-seeds", "K", 4, "seeds of the first round"),
-    ("--max-seeds", "K", 64, "seeds at most per point"),
-)
-SEED_TARGET_FIELDS = dict(p_halfwidth="p_halfwidth", tilt_halfwidth="tilt_halfwidth_deg",
-                          min_seeds="min_seeds", max_seeds="max_seeds")
+#: --seeds auto's targets (config.SEED_TARGETS: field and default): metavar, help.
+SEED_TARGET_HELP = {
+    "p_halfwidth": ("P", "largest half-width of each regime probability's 95%% Wilson "
+                    "interval"),
+    "tilt_halfwidth": ("DEG", "largest half-width of the median terminal tilt's 95%% "
+                       "bootstrap interval"),
+    "min_seeds": ("K", "seeds of the first round"),
+    "max_seeds": ("K", "seeds at most per point"),
+}
 RERUN_OPTIONS = ("method", "rtol", "atol")  # what --rerun-failed takes from the command line
 
 
@@ -161,11 +160,11 @@ def _parse_seeds(args):
                 from None
         if args.seeds < 1:
             raise ValueError(f"--seeds must be >= 1, got {args.seeds}")
-    given = {field: getattr(args, name) for name, field in SEED_TARGET_FIELDS.items()
+    given = {SEED_TARGETS[name][0]: getattr(args, name) for name in SEED_TARGETS
              if getattr(args, name) is not None}
     if args.seeds != "auto":
         if given:
-            name = next(k for k, v in SEED_TARGET_FIELDS.items() if v in given)
+            name = next(k for k in SEED_TARGETS if SEED_TARGETS[k][0] in given)
             raise ValueError(f"--{name.replace('_', '-')} applies only with --seeds auto")
         return None
     for flag, value in (("--cases", args.cases), ("--shard", args.shard),

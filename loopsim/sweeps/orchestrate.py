@@ -6,7 +6,9 @@ import os
 import numpy as np
 
 from .. import io, seeding, validation
-from ..config import DEFAULT_AUTO_CHUNK_SIZE, DEFAULT_CHUNK_SIZE, DEFAULT_N, DEFAULT_PERTURBATION
+from ..config import (
+    DEFAULT_AUTO_CHUNK_SIZE, DEFAULT_CHUNK_SIZE, DEFAULT_N, DEFAULT_PERTURBATION, SEED_TARGETS,
+)
 from .cases import SweepConfig, grid_cases, validate
 from .chunks import canonical_chunks, covered_ids, pending_pieces
 from .dask_backend import close_cluster, dask_client, run_dask
@@ -90,11 +92,6 @@ def run_sweep(config, out, threads=None, quiet=False, command_line=None, *, sche
     return io.read_results(out)
 
 
-#: ``sweep(seeds="auto")``'s keywords: the targets of ``seeding.SeedTargets``.
-SEED_TARGET_OPTIONS = dict(p_halfwidth="p_halfwidth", tilt_halfwidth="tilt_halfwidth_deg",
-                           min_seeds="min_seeds", max_seeds="max_seeds")
-
-
 def sweep(g0, theta0_deg, out, *, n=6, seeds=1, method=None, quiet=True, threads=None,
           scheduler=None, local_cluster=False, workers=None, **options):
     """The Python form of ``loopsim sweep``: every (g0, θ0, seed) of the grid into the
@@ -119,8 +116,7 @@ def sweep(g0, theta0_deg, out, *, n=6, seeds=1, method=None, quiet=True, threads
     seeds_auto = isinstance(seeds, str)
     if seeds_auto and seeds != "auto":
         raise ValueError(f"seeds must be a count or 'auto', got {seeds!r}")
-    targets = {SEED_TARGET_OPTIONS[k]: options.pop(k) for k in list(options)
-               if k in SEED_TARGET_OPTIONS}
+    targets = {SEED_TARGETS[k][0]: options.pop(k) for k in list(options) if k in SEED_TARGETS}
     if targets and not seeds_auto:
         raise ValueError(f"{sorted(targets)} apply only with seeds='auto'")
     perturbation = options.pop("perturbation", DEFAULT_PERTURBATION)
