@@ -120,7 +120,7 @@ class CompileClock(numba.core.event.Listener):
     without it (``seconds`` before and after, subtracted)."""
 
     NOTICE = ("loopsim: compiling numerical kernels for first use (cached for later runs; "
-              "about a minute on 2 cores) ...")
+              "30-60 s on 2 cores) ...")
 
     def __init__(self):
         self.seconds = 0.0

@@ -43,6 +43,7 @@ _GEQRF = types.ExternalFunction("numba_ez_geqrf", types.intc(
     types.char, types.intp, types.intp, types.CPointer(types.float64), types.intp,
     types.CPointer(types.float64)))
 _REAL = ord("d")
+_UPPER = ord("U")
 
 
 def lu_factor(a, piv):
@@ -144,7 +145,8 @@ def _scaled_normal_residual(block, scale, tau, residual, out):
     (``residual`` (M,) scratch: A τ + b)."""
     k = block.shape[0] - 1
     m = block.shape[1]
-    residual[:] = block[k]
+    for p in range(m):
+        residual[p] = block[k, p]
     for j in range(k):
         for p in range(m):
             residual[p] += block[j, p] * tau[j]
@@ -178,7 +180,7 @@ def least_squares_normal(block, scale, out, gram, residual, correction):
             gram[i, j] *= scale[i] * scale[j]
     # Row-major gram is LAPACK's column-major gramᵀ = gram; uplo "U" there leaves
     # gram = L Lᵀ with L in the row-major lower triangle.
-    info = _POTRF(_REAL, ord("U"), k, gram.ctypes, k)
+    info = _POTRF(_REAL, _UPPER, k, gram.ctypes, k)
     if info != 0:
         return info
     out[:] = 0.0

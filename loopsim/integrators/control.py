@@ -48,6 +48,9 @@ MAX_FACTOR = 10.0
 LANDING_STRETCH = 1e-8
 #: Consecutive quiet check intervals that make a steady state.
 STEADY_WINDOWS = 2
+#: Machine epsilon of float64, a constant for kernels (``np.finfo`` inside a kernel costs
+#: compile time).
+EPS = float(np.finfo(np.float64).eps)
 
 StepOptions = collections.namedtuple(
     "StepOptions",
@@ -106,6 +109,14 @@ def step_factor(err_norm, error_order):
 
 
 @numba.njit(**JIT)
+def copy_into(dst, src):
+    """dst[i] = src[i] for a 1-D src: an element loop, because a slice assignment
+    makes Numba compile its broadcasting-error message, seconds of compile time."""
+    for i in range(src.shape[0]):
+        dst[i] = src[i]
+
+
+@numba.njit(**JIT)
 def all_finite(a):
     for v in a.flat:
         if not np.isfinite(v):
@@ -137,7 +148,9 @@ def initial_step(problem, y0, f0, f1, rtol, atol, error_order, h_max):
     d0 = np.sqrt(d0 / ny)
     d1 = np.sqrt(d1 / ny)
     h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
-    y1 = y0 + h0 * f0
+    y1 = np.empty(ny)
+    for i in range(ny):
+        y1[i] = y0[i] + h0 * f0[i]
     rhs(problem, y1, f1)
     d2 = 0.0
     for i in range(ny):
@@ -157,9 +170,9 @@ def record_start(problem, y, t0, t_out, y_out, options):
     """Outputs at t0 and the initial monitor state (i_out, next_check, invariants, quiet)."""
     i_out = 0
     while i_out < t_out.shape[0] and t_out[i_out] <= t0:
-        y_out[i_out] = y
+        copy_into(y_out[i_out], y)
         i_out += 1
-    return i_out, t0 + options.steady_interval, steady_invariants(problem, y), 0
+    return i_out, t0 + options.steady_interval, steady_invariants(problem, y), np.int64(0)
 
 
 @numba.njit(**JIT)
@@ -227,6 +240,6 @@ def stop_check(options, n_steps, h, t, y):
     """Status that ends the run before the next attempt, or -1."""
     if n_steps >= options.max_steps:
         return STEP_BUDGET
-    if h < max(options.min_step, 10.0 * np.finfo(np.float64).eps * abs(t)):
+    if h < max(options.min_step, 10.0 * EPS * abs(t)):
         return STEP_UNDERFLOW if all_finite(y) else NON_FINITE
     return -1

@@ -17,7 +17,7 @@ from ..config import JIT
 from ..models import rhs
 from .base import advance, attempt, dense_output, start, statistics
 from .control import (
-    NON_FINITE, OK, all_finite, initial_step, initial_worst, landing, monitor, record_start,
+    NON_FINITE, OK, all_finite, copy_into, initial_step, initial_worst, landing, monitor, record_start,
     stop_check,
 )
 
@@ -63,8 +63,8 @@ def integrate(method, problem, y0, t0, t_end, t_out, options, y_out):
     y_new = np.empty(ny)
     y_old = np.empty(ny)
     f_old = np.empty(ny)
-    n_acc = 0
-    n_rej = 0
+    n_acc = np.int64(0)  # not the literal 0: one specialisation of the callees
+    n_rej = np.int64(0)
     t = t0
     worst = initial_worst(problem, y)
     rhs(problem, y, f)
@@ -95,16 +95,16 @@ def integrate(method, problem, y0, t0, t_end, t_out, options, y_out):
         n_acc += 1
         t_old = t
         t = t_end if clipped else t + h_try
-        y_old[:] = y
-        f_old[:] = f
-        y[:] = y_new
+        copy_into(y_old, y)
+        copy_into(f_old, f)
+        copy_into(y, y_new)
         rhs(problem, y, f)
         n_rhs += 1
         if not all_finite(f):
             return NON_FINITE, t, y, _counts(method, work, counts, n_acc, n_rej, n_rhs), worst
         while i_out < t_out.shape[0] and t_out[i_out] <= t:
             if t_out[i_out] == t:
-                y_out[i_out] = y
+                copy_into(y_out[i_out], y)
             else:  # its evaluations are output's, not the step's: not in nfev, so asking
                 # for output changes no count (a sweep's traced rows equal the others)
                 dense_output(method, work, problem, y_old, f_old, y, f, h_try,

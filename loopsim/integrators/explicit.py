@@ -14,7 +14,7 @@ import numpy as np
 from ..config import JIT
 from ..models import rhs
 from .base import advance, attempt, dense_output, implements, start, statistics
-from .control import error_scale, rms_norm, step_factor
+from .control import copy_into, error_scale, rms_norm, step_factor
 
 #: c (s,), a (s, s), b (s,), e (s,) arrays; error_order: p of the O(h^(p+1)) estimate.
 Tableau = collections.namedtuple("Tableau", "c a b e error_order")
@@ -79,7 +79,7 @@ def _explicit_start(method, problem, y, f, options):
 
 @implements(attempt, Tableau)
 def _explicit_attempt(method, work, problem, y, f, h, y_new, options):
-    work.k[0] = f
+    copy_into(work.k[0], f)
     evals = tableau_step(method, problem, y, h, work.k, work.stage, y_new, work.err)
     error_scale(y, y_new, options.rtol, options.atol, work.scale)
     err_norm = rms_norm(work.err, work.scale)
@@ -97,7 +97,7 @@ def _explicit_dense_output(method, work, problem, y_old, f_old, y, f, h, theta, 
     the integration itself (a cubic Hermite interpolant of the step is only third order:
     1e-6 relative errors at rtol 1e-8 on the Riccati test).  Costs s − 1 RHS evaluations
     per output time; the work arrays it overwrites are reset by the next attempt."""
-    work.k[0] = f_old
+    copy_into(work.k[0], f_old)
     return tableau_step(method, problem, y_old, theta * h, work.k, work.stage, out,
                         work.err)
 

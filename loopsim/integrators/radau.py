@@ -30,7 +30,7 @@ import numpy as np
 from ..config import JIT
 from ..models import jacobian, rhs
 from .base import advance, attempt, dense_output, implements, start, statistics
-from .control import MAX_FACTOR, MIN_FACTOR, SAFETY, rms_norm
+from .control import EPS, MAX_FACTOR, MIN_FACTOR, SAFETY, copy_into, rms_norm
 from ..linalg import PIVOT_DTYPE, lu_factor, lu_solve
 
 _S6 = np.sqrt(6.0)
@@ -115,8 +115,8 @@ def extrapolated_guess(q, ratio, z):
 @numba.njit(**JIT)
 def fd_jacobian(problem, y, f, jac, y_work, f_work):
     """jac[:, j] = (F(y + δ_j e_j) − F(y)) / δ_j, δ_j = √eps · max(1, |y_j|)."""
-    root_eps = np.sqrt(np.finfo(np.float64).eps)
-    y_work[:] = y
+    root_eps = np.sqrt(EPS)
+    copy_into(y_work, y)
     for j in range(y.shape[0]):
         delta = root_eps * max(1.0, abs(y[j]))
         y_work[j] = y[j] + delta
@@ -243,7 +243,7 @@ def _radau_start(method, problem, y, f, options):
     s[ERR_OLD] = -1.0
     s[REJECTED] = 0.0
     s[JAC_CURRENT] = 1.0
-    s[NEWTON_TOL] = max(NEWTON_TOL_FLOOR * np.finfo(np.float64).eps / options.rtol,
+    s[NEWTON_TOL] = max(NEWTON_TOL_FLOOR * EPS / options.rtol,
                         min(NEWTON_TOL_MAX, options.rtol ** 0.5))
     return work, evals
 

@@ -78,7 +78,9 @@ def _loop_invariants(problem, y):
 
 @implements(auxiliary, LoopProblem)
 def _loop_multiplier(problem, out):
-    out[:] = problem.ws.tension
+    tension = problem.ws.tension
+    for i in range(tension.shape[0]):
+        out[i] = tension[i]
 
 
 def constants(problem):

@@ -84,6 +84,7 @@ def shape_invariants(x):
             cov[a, b] = 0.5 * acc
     values, vectors = np.linalg.eigh(cov)
     out = np.empty(4)
-    out[:3] = values
+    for i in range(3):
+        out[i] = values[i]
     out[3] = abs(vectors[2, 0])
     return out
