@@ -17,8 +17,8 @@ from ..config import JIT
 from ..models import rhs
 from .base import advance, attempt, dense_output, start, statistics
 from .control import (
-    NON_FINITE, OK, all_finite, copy_into, initial_step, initial_worst, landing, monitor, record_start,
-    stop_check,
+    NON_FINITE, OK, all_finite, copy_into, initial_step, initial_worst, landing, monitor,
+    record_start, stop_check,
 )
 
 
