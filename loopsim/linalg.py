@@ -63,6 +63,15 @@ def _lu_factor(a, piv):
 
 
 @numba.njit(**JIT)
+def copy_into(dst, src):
+    """dst[i] = src[i] for i < len(src), src 1-D.  Kernels copy with this loop, not a
+    slice assignment (``dst[:] = src``), which makes Numba compile its broadcasting
+    check's error message: seconds of compile time per call site's signature."""
+    for i in range(src.shape[0]):
+        dst[i] = src[i]
+
+
+@numba.njit(**JIT)
 def lu_solve(lu, piv, b):
     """Solve a x = b in place of b from :func:`lu_factor`'s lu and piv."""
     n = lu.shape[0]
@@ -145,8 +154,7 @@ def _scaled_normal_residual(block, scale, tau, residual, out):
     (``residual`` (M,) scratch: A τ + b)."""
     k = block.shape[0] - 1
     m = block.shape[1]
-    for p in range(m):
-        residual[p] = block[k, p]
+    copy_into(residual, block[k])
     for j in range(k):
         for p in range(m):
             residual[p] += block[j, p] * tau[j]

@@ -17,6 +17,7 @@ import numba
 import numpy as np
 
 from ..config import JIT
+from ..linalg import copy_into
 from ..models import constraint_error, resolution_error, resolution_size, rhs, steady_invariants
 
 # ---- status codes: the driver never raises; a run ends with one of these ----
@@ -106,14 +107,6 @@ def step_factor(err_norm, error_order):
     if not np.isfinite(err_norm):
         return MIN_FACTOR
     return min(MAX_FACTOR, max(MIN_FACTOR, SAFETY * err_norm ** (-1.0 / (error_order + 1))))
-
-
-@numba.njit(**JIT)
-def copy_into(dst, src):
-    """dst[i] = src[i] for a 1-D src: an element loop, because a slice assignment
-    makes Numba compile its broadcasting-error message, seconds of compile time."""
-    for i in range(src.shape[0]):
-        dst[i] = src[i]
 
 
 @numba.njit(**JIT)

@@ -14,10 +14,11 @@ import numba
 import numpy as np
 
 from ..config import JIT
+from ..linalg import copy_into
 from ..models import rhs
 from .base import advance, attempt, dense_output, start, statistics
 from .control import (
-    NON_FINITE, OK, all_finite, copy_into, initial_step, initial_worst, landing, monitor,
+    NON_FINITE, OK, all_finite, initial_step, initial_worst, landing, monitor,
     record_start, stop_check,
 )
 

@@ -12,9 +12,10 @@ import numba
 import numpy as np
 
 from ..config import JIT
+from ..linalg import copy_into
 from ..models import rhs
 from .base import advance, attempt, dense_output, implements, start, statistics
-from .control import copy_into, error_scale, rms_norm, step_factor
+from .control import error_scale, rms_norm, step_factor
 
 #: c (s,), a (s, s), b (s,), e (s,) arrays; error_order: p of the O(h^(p+1)) estimate.
 Tableau = collections.namedtuple("Tableau", "c a b e error_order")

@@ -30,8 +30,8 @@ import numpy as np
 from ..config import JIT
 from ..models import jacobian, rhs
 from .base import advance, attempt, dense_output, implements, start, statistics
-from .control import EPS, MAX_FACTOR, MIN_FACTOR, SAFETY, copy_into, rms_norm
-from ..linalg import PIVOT_DTYPE, lu_factor, lu_solve
+from .control import EPS, MAX_FACTOR, MIN_FACTOR, SAFETY, rms_norm
+from ..linalg import PIVOT_DTYPE, copy_into, lu_factor, lu_solve
 
 _S6 = np.sqrt(6.0)
 C = np.array([(4.0 - _S6) / 10.0, (4.0 + _S6) / 10.0, 1.0])

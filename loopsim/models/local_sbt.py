@@ -8,6 +8,7 @@ tail and steady-state invariants).  Their names are re-exported here.
 """
 import collections
 
+from ..linalg import copy_into
 from .base import (
     auxiliary, constraint_error, for_case, implements, jacobian, resolution_error,
     resolution_size, rhs, steady_invariants,
@@ -78,9 +79,7 @@ def _loop_invariants(problem, y):
 
 @implements(auxiliary, LoopProblem)
 def _loop_multiplier(problem, out):
-    tension = problem.ws.tension
-    for i in range(tension.shape[0]):
-        out[i] = tension[i]
+    copy_into(out, problem.ws.tension)
 
 
 def constants(problem):

@@ -4,6 +4,7 @@ import numba
 import numpy as np
 
 from ..config import DEFORMATION_FLOOR, JIT
+from ..linalg import copy_into
 
 
 @numba.njit(**JIT)
@@ -84,7 +85,6 @@ def shape_invariants(x):
             cov[a, b] = 0.5 * acc
     values, vectors = np.linalg.eigh(cov)
     out = np.empty(4)
-    for i in range(3):
-        out[i] = values[i]
+    copy_into(out, values)  # out[:3]
     out[3] = abs(vectors[2, 0])
     return out
