@@ -23,9 +23,11 @@ import numba.core.event
 
 PACKAGE_DIR = os.path.dirname(os.path.abspath(__file__))
 PACKAGE = os.path.basename(PACKAGE_DIR)
-#: Code (not prose) that marks a module as defining compiled code: a Numba decorator
-#: or the extension API.
-KERNEL_CODE = re.compile(r"^\s*(@numba\.|@njit|@overload|from numba\.extending import)", re.M)
+#: Code (not prose) that marks a module as defining compiled code: a Numba decorator,
+#: loopsim's (``jit.kernel``, ``jit.entry``, ``dispatch.implements``) or the extension API.
+KERNEL_CODE = re.compile(
+    r"^\s*(@numba\.|@njit|@overload|@kernel|@entry|@implements|from numba\.extending import)",
+    re.M)
 
 
 def source_hash(paths=None):

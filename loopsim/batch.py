@@ -15,12 +15,13 @@ import numpy as np
 
 from .config import JIT
 from .integrators import COUNTS, integrate
+from .jit import entry
 from .models import for_case
 
 _PARALLEL_JIT = dict(JIT, parallel=True)
 
 
-@numba.njit(**JIT)
+@entry  # called from Python too, by one-thread sweeps
 def run_lane(lane, lanes, method, constants, parameters, x0, t0, t_end, options, order, y_final,
              t_final, status, counts, worst):
     """Integrate the cases order[lane], order[lane + lanes], ...; case b writes only row b."""

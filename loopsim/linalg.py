@@ -23,6 +23,7 @@ from numba.extending import overload
 from numba.np.linalg import F_INT_nbtype, F_INT_nptype, ensure_lapack
 
 from .config import JIT
+from .jit import kernel
 
 ensure_lapack()
 #: Integer type of the pivot array (LAPACK's Fortran integer).
@@ -62,7 +63,7 @@ def _lu_factor(a, piv):
     return factor
 
 
-@numba.njit(**JIT)
+@kernel
 def copy_into(dst, src):
     """dst[i] = src[i] for i < len(src), src 1-D.  Kernels copy with this loop, not a
     slice assignment (``dst[:] = src``), which makes Numba compile its broadcasting
@@ -71,7 +72,7 @@ def copy_into(dst, src):
         dst[i] = src[i]
 
 
-@numba.njit(**JIT)
+@kernel
 def lu_solve(lu, piv, b):
     """Solve a x = b in place of b from :func:`lu_factor`'s lu and piv."""
     n = lu.shape[0]
@@ -93,13 +94,13 @@ def lu_solve(lu, piv, b):
             b[p] = tmp
 
 
-@numba.njit(**JIT)
+@kernel
 def factor(a, piv):
     """:func:`lu_factor` callable from Python (tests, benchmarks)."""
     return lu_factor(a, piv)
 
 
-@numba.njit(**JIT)
+@kernel
 def least_squares_affine(block, out, tau):
     """Solve min_τ ||A τ + b||₂ for the block stored column-major: rows 0..K-1 of
     ``block`` (K+1, M) are the columns of A (M, K), row K is b; block is destroyed.
@@ -132,7 +133,7 @@ _POTRF = types.ExternalFunction("numba_xxpotrf", types.intc(
     types.char, types.char, types.intp, types.CPointer(types.float64), types.intp))
 
 
-@numba.njit(**JIT)
+@kernel
 def _cholesky_solve(factor, rhs):
     """Solve L Lᵀ y = rhs in place, L the row-major lower triangle of ``factor``."""
     k = rhs.shape[0]
@@ -148,7 +149,7 @@ def _cholesky_solve(factor, rhs):
         rhs[i] = acc / factor[i, i]
 
 
-@numba.njit(**JIT)
+@kernel
 def _scaled_normal_residual(block, scale, tau, residual, out):
     """out = −D Aᵀ (A τ + b): the normal equations' residual in the scaled unknowns
     (``residual`` (M,) scratch: A τ + b)."""
@@ -165,7 +166,7 @@ def _scaled_normal_residual(block, scale, tau, residual, out):
         out[j] = -scale[j] * acc
 
 
-@numba.njit(**JIT)
+@kernel
 def least_squares_normal(block, scale, out, gram, residual, correction):
     """Solve min_τ ||A τ + b||₂ (block as in :func:`least_squares_affine`, not destroyed)
     by Björck's corrected semi-normal equations on the column-scaled problem:

@@ -13,12 +13,11 @@ with p the order of the error estimate.
 """
 import collections
 
-import numba
 import numpy as np
 
-from ..config import JIT
+from ..jit import kernel
 from ..linalg import copy_into
-from ..models import constraint_error, resolution_error, resolution_size, rhs, steady_invariants
+from ..models import constraint_error, resolution_error, resolution_size, steady_invariants
 
 # ---- status codes: the driver never raises; a run ends with one of these ----
 OK = 0
@@ -83,7 +82,7 @@ def step_options(rtol, atol, first_step=None, min_step=0.0, max_step=np.inf,
                        float(steady_interval), float(steady_tol), float(resolution_tol))
 
 
-@numba.njit(**JIT)
+@kernel
 def rms_norm(v, scale):
     """sqrt(mean((v_i / scale_i)²))."""
     acc = 0.0
@@ -92,14 +91,14 @@ def rms_norm(v, scale):
     return np.sqrt(acc / v.shape[0])
 
 
-@numba.njit(**JIT)
+@kernel
 def error_scale(y, y_new, rtol, atol, scale):
     """scale_i = atol + rtol max(|y_i|, |y_new_i|), written into ``scale``."""
     for i in range(y.shape[0]):
         scale[i] = atol + rtol * max(abs(y[i]), abs(y_new[i]))
 
 
-@numba.njit(**JIT)
+@kernel
 def step_factor(err_norm, error_order):
     """Step-size factor SAFETY err^(-1/(p+1)), clipped to [MIN_FACTOR, MAX_FACTOR]."""
     if err_norm == 0.0:
@@ -109,7 +108,7 @@ def step_factor(err_norm, error_order):
     return min(MAX_FACTOR, max(MIN_FACTOR, SAFETY * err_norm ** (-1.0 / (error_order + 1))))
 
 
-@numba.njit(**JIT)
+@kernel
 def all_finite(a):
     for v in a.flat:
         if not np.isfinite(v):
@@ -117,7 +116,7 @@ def all_finite(a):
     return True
 
 
-@numba.njit(**JIT)
+@kernel
 def max_abs_difference(a, b):
     worst = 0.0
     for i in range(a.shape[0]):
@@ -125,12 +124,12 @@ def max_abs_difference(a, b):
     return worst
 
 
-@numba.njit(**JIT)
-def initial_step(problem, y0, f0, f1, rtol, atol, error_order, h_max):
-    """Starting step by the Hairer–Nørsett–Wanner heuristic (as scipy's); f1 is scratch.
-
-    Costs one right-hand-side evaluation.
-    """
+@kernel
+def initial_step_probe(y0, f0, rtol, atol, y1):
+    """First half of the Hairer–Nørsett–Wanner starting step (as scipy's): with
+    ‖v‖ = rms(v_i / (atol + rtol |y0_i|)), h0 = 0.01 ‖y0‖ / ‖f0‖ (1e-6 if either norm is
+    below 1e-5) and y1 = y0 + h0 f0 (written).  Returns (h0, ‖f0‖); the caller evaluates
+    F(y1) for :func:`initial_step`."""
     ny = y0.shape[0]
     d0 = 0.0
     d1 = 0.0
@@ -141,24 +140,34 @@ def initial_step(problem, y0, f0, f1, rtol, atol, error_order, h_max):
     d0 = np.sqrt(d0 / ny)
     d1 = np.sqrt(d1 / ny)
     h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
-    y1 = np.empty(ny)
     for i in range(ny):
         y1[i] = y0[i] + h0 * f0[i]
-    rhs(problem, y1, f1)
+    return h0, d1
+
+
+@kernel
+def initial_step(y0, f0, f1, h0, f0_norm, rtol, atol, error_order, h_max):
+    """Second half of the starting step (:func:`initial_step_probe` gave h0 and ‖f0‖;
+    f1 = F(y0 + h0 f0)): with d2 = ‖f1 − f0‖ / h0, h1 = (0.01 / max(‖f0‖, d2))^(1/(p+1))
+    (max(1e-6, 1e-3 h0) if both are below 1e-15); returns min(100 h0, h1, h_max).
+
+    The right-hand side is the caller's to evaluate: this kernel holds no model code.
+    """
+    ny = y0.shape[0]
     d2 = 0.0
     for i in range(ny):
         scale = atol + rtol * abs(y0[i])
         d2 += ((f1[i] - f0[i]) / scale) ** 2
     d2 = np.sqrt(d2 / ny) / h0
-    if d1 <= 1e-15 and d2 <= 1e-15:
+    if f0_norm <= 1e-15 and d2 <= 1e-15:
         h1 = max(1e-6, h0 * 1e-3)
     else:
-        h1 = (0.01 / max(d1, d2)) ** (1.0 / (error_order + 1))
+        h1 = (0.01 / max(f0_norm, d2)) ** (1.0 / (error_order + 1))
     return min(100.0 * h0, h1, h_max)
 
 
 # ---- output times and monitors ----------------------------------------------
-@numba.njit(**JIT)
+@kernel
 def record_start(problem, y, t0, t_out, y_out, options):
     """Outputs at t0 and the initial monitor state (i_out, next_check, invariants, quiet)."""
     i_out = 0
@@ -168,7 +177,7 @@ def record_start(problem, y, t0, t_out, y_out, options):
     return i_out, t0 + options.steady_interval, steady_invariants(problem, y), np.int64(0)
 
 
-@numba.njit(**JIT)
+@kernel
 def initial_worst(problem, y):
     """The monitors' record at the start (see :func:`monitor`): no constraint error yet
     (the start's is the user's), no resolution error counted yet, the start's
@@ -178,7 +187,7 @@ def initial_worst(problem, y):
     return worst
 
 
-@numba.njit(**JIT)
+@kernel
 def landing(t, h, t_end):
     """Step to try from t: h, shortened to land exactly on t_end (or stretched by up to
     LANDING_STRETCH rather than leave a sliver).  Output times are not landed on: they
@@ -191,7 +200,7 @@ def landing(t, h, t_end):
     return h, False
 
 
-@numba.njit(**JIT)
+@kernel
 def monitor(problem, t, y, t_end, options, worst, next_check, previous, quiet):
     """After an accepted step: constraint error, resolution and steady state.
 
@@ -228,7 +237,7 @@ def monitor(problem, t, y, t_end, options, worst, next_check, previous, quiet):
     return -1, next_check, previous, quiet
 
 
-@numba.njit(**JIT)
+@kernel
 def stop_check(options, n_steps, h, t, y):
     """Status that ends the run before the next attempt, or -1."""
     if n_steps >= options.max_steps:

@@ -10,15 +10,14 @@ method-specific pieces (``start``, ``attempt``, ``advance``, ``dense_output``,
 ``statistics``; see ``integrators.base``) are resolved on the method's type
 when the driver is compiled.
 """
-import numba
 import numpy as np
 
-from ..config import JIT
+from ..jit import entry, kernel
 from ..linalg import copy_into
 from ..models import rhs
 from .base import advance, attempt, dense_output, start, statistics
 from .control import (
-    NON_FINITE, OK, all_finite, initial_step, initial_worst, landing, monitor,
+    NON_FINITE, OK, all_finite, initial_step, initial_step_probe, initial_worst, landing, monitor,
     record_start, stop_check,
 )
 
@@ -28,7 +27,7 @@ from .control import (
 COUNTS = ("steps_accepted", "steps_rejected", "nfev", "njev", "nlu")
 
 
-@numba.njit(**JIT)
+@kernel
 def _counts(method, work, counts, n_acc, n_rej, n_rhs):
     njev, nlu = statistics(method, work)
     counts[0] = n_acc
@@ -39,7 +38,7 @@ def _counts(method, work, counts, n_acc, n_rej, n_rhs):
     return counts
 
 
-@numba.njit(**JIT)
+@entry
 def integrate(method, problem, y0, t0, t_end, t_out, options, y_out):
     """Integrate dy/dt = rhs(problem, y) from t0 to t_end with ``method`` and ``options``
     (``control.step_options``).
@@ -79,9 +78,11 @@ def integrate(method, problem, y0, t0, t_end, t_out, options, y_out):
     if options.first_step > 0.0:
         h = min(options.first_step, options.max_step)
     else:
-        h = initial_step(problem, y, f, y_new, options.rtol, options.atol, method.error_order,
-                         options.max_step)
+        h0, f_norm = initial_step_probe(y, f, options.rtol, options.atol, y_old)
+        rhs(problem, y_old, y_new)
         n_rhs += 1
+        h = initial_step(y, f, y_new, h0, f_norm, options.rtol, options.atol,
+                         method.error_order, options.max_step)
     while t < t_end:
         stop = stop_check(options, n_acc + n_rej, h, t, y)
         if stop >= 0:
@@ -109,7 +110,7 @@ def integrate(method, problem, y0, t0, t_end, t_out, options, y_out):
             else:  # its evaluations are output's, not the step's: not in nfev, so asking
                 # for output changes no count (a sweep's traced rows equal the others)
                 dense_output(method, work, problem, y_old, f_old, y, f, h_try,
-                             (t_out[i_out] - t_old) / h_try, y_out[i_out])
+                             (t_out[i_out] - t_old) / h_try, y_out[i_out], options)
             i_out += 1
         stop, next_check, previous, quiet = monitor(
             problem, t, y, t_end, options, worst, next_check, previous, quiet)

@@ -2,16 +2,14 @@
 
 A :class:`Tableau` holds c, a (strictly lower triangular), the propagating
 weights b and the error weights e = b − b̂ (b̂ the embedded weights) and the
-order p of the error estimate; :func:`tableau_step` takes one step of any
+order p of the error estimate; the ``attempt`` implementation takes one step of any
 tableau.  Adding an explicit method is adding a ``Tableau`` constant and a
 name in ``integrators.METHODS``.
 """
 import collections
 
-import numba
 import numpy as np
 
-from ..config import JIT
 from ..linalg import copy_into
 from ..models import rhs
 from .base import advance, attempt, dense_output, implements, start, statistics
@@ -42,34 +40,6 @@ RKF45 = Tableau(RKF45_C, RKF45_A, RKF45_B5, RKF45_B5 - RKF45_B4, 4)
 ExplicitWork = collections.namedtuple("ExplicitWork", "k stage err scale")
 
 
-@numba.njit(**JIT)
-def tableau_step(tableau, problem, y, h, k, stage, y_new, err):
-    """One step of an explicit tableau from y with step h: y_new = y + h Σ b_j k_j and
-    err = h Σ e_j k_j, with k_s = F(y + h Σ_{j<s} a_sj k_j).
-
-    k[0] must hold F(y) on entry; k[1:] and ``stage`` are overwritten.
-    Returns the number of right-hand-side evaluations made (s − 1).
-    """
-    ny = y.shape[0]
-    stages = tableau.c.shape[0]
-    for s in range(1, stages):
-        for i in range(ny):
-            acc = 0.0
-            for j in range(s):
-                acc += tableau.a[s, j] * k[j, i]
-            stage[i] = y[i] + h * acc
-        rhs(problem, stage, k[s])
-    for i in range(ny):
-        acc_b = 0.0
-        acc_e = 0.0
-        for j in range(stages):
-            acc_b += tableau.b[j] * k[j, i]
-            acc_e += tableau.e[j] * k[j, i]
-        y_new[i] = y[i] + h * acc_b
-        err[i] = h * acc_e
-    return stages - 1
-
-
 @implements(start, Tableau)
 def _explicit_start(method, problem, y, f, options):
     ny = y.shape[0]
@@ -80,11 +50,35 @@ def _explicit_start(method, problem, y, f, options):
 
 @implements(attempt, Tableau)
 def _explicit_attempt(method, work, problem, y, f, h, y_new, options):
-    copy_into(work.k[0], f)
-    evals = tableau_step(method, problem, y, h, work.k, work.stage, y_new, work.err)
+    """One step of the tableau from y (f = F(y)) with step h: y_new = y + h Σ b_j k_j and
+    err = h Σ e_j k_j, with k_s = F(y + h Σ_{j<s} a_sj k_j), k_0 = f; accepted when the
+    RMS norm of err in the scale atol + rtol max(|y|, |y_new|) is at most 1.
+
+    Overwrites work.k, work.stage, work.err and work.scale; costs s − 1 RHS evaluations.
+    """
+    k = work.k
+    stage = work.stage
+    copy_into(k[0], f)
+    ny = y.shape[0]
+    stages = method.c.shape[0]
+    for s in range(1, stages):
+        for i in range(ny):
+            acc = 0.0
+            for j in range(s):
+                acc += method.a[s, j] * k[j, i]
+            stage[i] = y[i] + h * acc
+        rhs(problem, stage, k[s])
+    for i in range(ny):
+        acc_b = 0.0
+        acc_e = 0.0
+        for j in range(stages):
+            acc_b += method.b[j] * k[j, i]
+            acc_e += method.e[j] * k[j, i]
+        y_new[i] = y[i] + h * acc_b
+        work.err[i] = h * acc_e
     error_scale(y, y_new, options.rtol, options.atol, work.scale)
     err_norm = rms_norm(work.err, work.scale)
-    return err_norm <= 1.0, h * step_factor(err_norm, method.error_order), evals
+    return err_norm <= 1.0, h * step_factor(err_norm, method.error_order), stages - 1
 
 
 @implements(advance, Tableau)
@@ -93,14 +87,14 @@ def _explicit_advance(method, work, problem, y, f, h, h_proposal):
 
 
 @implements(dense_output, Tableau)
-def _explicit_dense_output(method, work, problem, y_old, f_old, y, f, h, theta, out):
-    """One extra step of the tableau from y_old of size θh, on the side: as accurate as
-    the integration itself (a cubic Hermite interpolant of the step is only third order:
-    1e-6 relative errors at rtol 1e-8 on the Riccati test).  Costs s − 1 RHS evaluations
-    per output time; the work arrays it overwrites are reset by the next attempt."""
-    copy_into(work.k[0], f_old)
-    return tableau_step(method, problem, y_old, theta * h, work.k, work.stage, out,
-                        work.err)
+def _explicit_dense_output(method, work, problem, y_old, f_old, y, f, h, theta, out,
+                           options):
+    """One extra step of the tableau from y_old of size θh, on the side (an attempt whose
+    verdict is ignored): as accurate as the integration itself (a cubic Hermite
+    interpolant of the step is only third order: 1e-6 relative errors at rtol 1e-8 on
+    the Riccati test).  Costs s − 1 RHS evaluations per output time; the work arrays it
+    overwrites are reset by the next attempt."""
+    return attempt(method, work, problem, y_old, f_old, theta * h, out, options)[2]
 
 
 @implements(statistics, Tableau)

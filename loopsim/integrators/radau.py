@@ -24,10 +24,9 @@ for new models.  Everything writes into caller-owned arrays.
 """
 import collections
 
-import numba
 import numpy as np
 
-from ..config import JIT
+from ..jit import kernel
 from ..models import jacobian, rhs
 from .base import advance, attempt, dense_output, implements, start, statistics
 from .control import EPS, MAX_FACTOR, MIN_FACTOR, SAFETY, rms_norm
@@ -92,7 +91,7 @@ E = _embedded_weights(MU_REAL)
 VINV = np.linalg.inv(np.vander(C, 4, increasing=True)[:, 1:])
 
 
-@numba.njit(**JIT)
+@kernel
 def collocation_polynomial(z, q):
     """q (3, n) with y(t_old + x h) = y_old + Σ_k q_k x^(k+1), from the stage increments z."""
     for k in range(3):
@@ -100,7 +99,7 @@ def collocation_polynomial(z, q):
             q[k, i] = VINV[k, 0] * z[0, i] + VINV[k, 1] * z[1, i] + VINV[k, 2] * z[2, i]
 
 
-@numba.njit(**JIT)
+@kernel
 def extrapolated_guess(q, ratio, z):
     """Newton start for the next step (h_new = ratio · h_old): the last step's collocation
     polynomial evaluated at the new stage times, minus its end value."""
@@ -112,7 +111,7 @@ def extrapolated_guess(q, ratio, z):
 
 
 # ---- Newton matrices, iteration and error estimate -----------------------
-@numba.njit(**JIT)
+@kernel
 def fd_jacobian(problem, y, f, jac, y_work, f_work):
     """jac[:, j] = (F(y + δ_j e_j) − F(y)) / δ_j, δ_j = √eps · max(1, |y_j|)."""
     root_eps = np.sqrt(EPS)
@@ -127,7 +126,7 @@ def fd_jacobian(problem, y, f, jac, y_work, f_work):
         y_work[j] = y[j]
 
 
-@numba.njit(**JIT)
+@kernel
 def newton_matrices(jac, h, lu_real, piv_real, lu_complex, piv_complex):
     """Factorise μ_r/h − J and μ_c/h − J."""
     n = jac.shape[0]
@@ -141,7 +140,7 @@ def newton_matrices(jac, h, lu_real, piv_real, lu_complex, piv_complex):
     lu_factor(lu_complex, piv_complex)
 
 
-@numba.njit(**JIT)
+@kernel
 def solve_collocation(problem, y, h, z, scale, tol, maxiter, lu_real, piv_real, lu_complex,
                       piv_complex, w, fz, stage, real_rhs, complex_rhs):
     """Simplified Newton for Z = h A F(y + Z), from the guess in z (3, n), updated in place.
@@ -196,7 +195,7 @@ def solve_collocation(problem, y, h, z, scale, tol, maxiter, lu_real, piv_real, 
     return False, maxiter, rate
 
 
-@numba.njit(**JIT)
+@kernel
 def error_estimate(f0, z, h, lu_real, piv_real, out):
     """out = (μ_r/h − J)⁻¹ (f(y) + Σ E_i Z_i / h)."""
     for i in range(f0.shape[0]):
@@ -205,7 +204,7 @@ def error_estimate(f0, z, h, lu_real, piv_real, out):
 
 
 # ---- step control (Hairer's policies, as scipy's Radau) -----------------------
-@numba.njit(**JIT)
+@kernel
 def predictive_factor(h, h_old, err_norm, err_old):
     """Gustafsson's predictive step factor, before the safety factor:
     min(1, (h / h_old)(err_old / err)^(1/4)) err^(-1/4)."""
@@ -325,7 +324,7 @@ def _radau_advance(method, work, problem, y, f, h, h_proposal):
 
 
 @implements(dense_output, RadauIIA)
-def _radau_dense_output(method, work, problem, y_old, f_old, y, f, h, theta, out):
+def _radau_dense_output(method, work, problem, y_old, f_old, y, f, h, theta, out, options):
     """The collocation polynomial of the step: y_old + Σ_k q_k θ^(k+1) (order 3)."""
     q = work.poly
     for i in range(y.shape[0]):

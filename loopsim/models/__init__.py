@@ -6,9 +6,8 @@
 A new model (say, nonlocal hydrodynamics) is one module implementing the
 interface, imported here so its implementations are registered.
 """
-import numba
 
-from ..config import JIT
+from ..jit import entry, kernel
 from . import local_sbt, riccati  # noqa: F401 - importing registers the implementations
 from .base import (
     auxiliary, constraint_error, for_case, implements, jacobian, resolution_error,
@@ -21,7 +20,7 @@ __all__ = ["rhs", "jacobian", "constraint_error", "resolution_error", "resolutio
            "for_case", "implements", "evaluate", "local_sbt", "riccati"]
 
 
-@numba.njit(**JIT)
+@entry
 def evaluate(problem, y, dydt, aux):
     """dydt = F(y) and the model's auxiliary field at y (the tension multiplier of a loop)."""
     rhs(problem, y, dydt)

@@ -36,11 +36,10 @@ for the Jacobian and as the reference the fast path is tested against.
 import collections
 import functools
 
-import numba
 import numpy as np
 
 from .. import spectral
-from ..config import JIT
+from ..jit import entry, kernel
 from ..linalg import least_squares_affine, least_squares_normal
 
 #: the map T -> ε (leading order 2 T'') for the normal-equations solve.
@@ -85,7 +84,7 @@ def make_operators(n):
     )
 
 
-@numba.njit(**JIT)
+@entry
 def make_workspace(n):
     m = 4 * n + 1
     k = 2 * n + 1
@@ -99,7 +98,7 @@ def make_workspace(n):
     )
 
 
-@numba.njit(**JIT)
+@kernel
 def shape_on_grid(x, ops, ws):
     """Grid values of x', x'' and x'''' from coefficients x (3, K)."""
     np.dot(x, ops.S1T, ws.tangent)
@@ -107,7 +106,7 @@ def shape_on_grid(x, ops, ws):
     np.dot(x, ops.S4T, ws.x4)
 
 
-@numba.njit(**JIT)
+@kernel
 def force_map(g0, ops, ws):
     """Map (1): f = P_n[(T x')' - x'''' - g0 e_z], as a block of columns.
 
@@ -125,7 +124,7 @@ def force_map(g0, ops, ws):
     np.dot(ops.P, raw.reshape((m, 3 * (k + 1))), ws.force.reshape((m, 3 * (k + 1))))
 
 
-@numba.njit(**JIT)
+@kernel
 def velocity_map(ws):
     """Map (2) before projection: u = f + (x'·f) x'  (stored in ws.mobile)."""
     t, f = ws.tangent, ws.force
@@ -137,7 +136,7 @@ def velocity_map(ws):
                 ws.mobile[i, c, j] = f[i, c, j] + h * t[c, i]
 
 
-@numba.njit(**JIT)
+@kernel
 def length_creation_map(w, ops, ws):
     """Map (3): ε = x'·(P_n u)' - w (1 - x'·x'), as a block of columns (stored as rows)."""
     m, cols = ops.m, ws.mobile.shape[2]
@@ -151,7 +150,7 @@ def length_creation_map(w, ops, ws):
         ws.length_rate[k, i] -= w * (1.0 - stretch)
 
 
-@numba.njit(**JIT)
+@kernel
 def compose_maps(x, g0, w, ops, ws):
     """Maps (1)-(3) for shape x: the affine map T -> ε as the block ws.length_rate."""
     shape_on_grid(x, ops, ws)
@@ -160,7 +159,7 @@ def compose_maps(x, g0, w, ops, ws):
     length_creation_map(w, ops, ws)
 
 
-@numba.njit(**JIT)
+@kernel
 def tension_operator(ops, ws):
     """Bᵀ and B₂ᵀ into ws.coupling: B = P1 ∘ G, B₂ = P2 ∘ G, G_il = t_i·t_l (t = x' on the grid).
 
@@ -184,7 +183,7 @@ def tension_operator(ops, ws):
             coupling[m + l, i] = ops.P2T[l, i] * g
 
 
-@numba.njit(**JIT)
+@kernel
 def length_rate_operator(g0, w, ops, ws):
     """The affine map T -> ε into ws.length_rate: rows 0..K-1 the columns of
     A = (B₂ + B B) S0 (stored Aᵀ = S0ᵀ B₂ᵀ + (S0ᵀ Bᵀ) Bᵀ), row K the T = 0 part b.
@@ -219,7 +218,7 @@ def length_rate_operator(g0, w, ops, ws):
                 - w * (1.0 - stretch))
 
 
-@numba.njit(**JIT)
+@entry  # also called from Python, by the steady-branch analysis (stability.steady)
 def loop_velocity(x, g0, w, ops, ws, u_out):
     """Velocity coefficients u (3, K) of the shape x (3, K); tension left in ws.tension.
 
@@ -251,7 +250,7 @@ def loop_velocity(x, g0, w, ops, ws, u_out):
     np.dot(ws.velocity, ops.FT, u_out)
 
 
-@numba.njit(**JIT)
+@kernel
 def loop_velocity_blocks(x, g0, w, ops, ws, u_out):
     """:func:`loop_velocity` through the column blocks of :func:`compose_maps`: the
     previous dense path, kept as the Jacobian's first step and as the fast path's reference.
@@ -270,7 +269,7 @@ def loop_velocity_blocks(x, g0, w, ops, ws, u_out):
     np.dot(ws.velocity, ops.FT, u_out)
 
 
-@numba.njit(**JIT)
+@kernel
 def length_creation(x, tension, g0, w, ops, ws):
     """Grid values of ε for a given tension (the residual of the tension solve)."""
     compose_maps(x, g0, w, ops, ws)

@@ -1,13 +1,13 @@
 """What the driver monitors on a loop (x the (3, 2n+1) position coefficients): its length
 error, its spectral tail and the shape invariants that define a steady state."""
-import numba
 import numpy as np
 
-from ..config import DEFORMATION_FLOOR, JIT
+from ..config import DEFORMATION_FLOOR
+from ..jit import kernel
 from ..linalg import copy_into
 
 
-@numba.njit(**JIT)
+@kernel
 def relative_length_error(x, ops, ws):
     """(L - 2π) / 2π with L = ∫|x'| ds by the trapezoid rule on the M-point grid.
 
@@ -23,7 +23,7 @@ def relative_length_error(x, ops, ws):
     return total / ops.m - 1.0
 
 
-@numba.njit(**JIT)
+@kernel
 def energy_sums(x):
     """(Σ_{k ≥ 1} E_k, Σ_{k ≥ 2} E_k, Σ_{k ≥ max(2, n-1)} E_k) of x (3, 2n+1), with
     E_k = ½ Σ_xyz (a_k² + b_k²) (the ½ cancels in every ratio: left out)."""
@@ -44,7 +44,7 @@ def energy_sums(x):
     return total, deformation, top
 
 
-@numba.njit(**JIT)
+@kernel
 def spectral_tail(x):
     """Share of the loop's deformation carried by its top modes k ≥ max(2, n − 1), x (3, 2n+1):
 
@@ -60,7 +60,7 @@ def spectral_tail(x):
     return np.sqrt(top / scale) if scale > 0.0 else 0.0
 
 
-@numba.njit(**JIT)
+@kernel
 def top_mode_share(x):
     """RMS amplitude of the top modes k ≥ max(2, n − 1) of x relative to the loop's,
     sqrt(Σ_{k ≥ max(2, n-1)} E_k / Σ_{k ≥ 1} E_k): the absolute size of the tail."""
@@ -68,7 +68,7 @@ def top_mode_share(x):
     return np.sqrt(top / total) if total > 0.0 else 0.0
 
 
-@numba.njit(**JIT)
+@kernel
 def shape_invariants(x):
     """Covariance eigenvalues (size and shape; invariant under rigid motions and
     arc-length shifts) and |n_z| of the best-fit plane's normal (the tilt), as one array.

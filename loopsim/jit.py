@@ -1,0 +1,82 @@
+"""The two ways loopsim compiles a function (Numba nopython mode, cached on disk).
+
+``@entry``: a function Python calls in production (``integrate``, ``evaluate``, the batch
+kernel's helpers): a plain ``numba.njit`` dispatcher with its Python entry wrapper.
+
+``@kernel``: a function compiled code calls.  It is compiled *without* the Python
+(``cpython``) and C (``cfunc``) entry wrappers Numba would build by default: for a
+kernel taking a problem namedtuple (some 40 arrays) the wrappers are a fifth of its
+machine code, compiled again in every caller's module, and a cold first run spends
+about a fifth less time compiling without them (docs/performance.md, "Compilation").
+Jitted callers see the plain dispatcher (``_numba_type_``); a call from Python (tests,
+interactive use) goes through a small uncached trampoline compiled on first use, so
+calling a kernel from Python works, only its first call compiles more than an entry's.
+"""
+import functools
+
+import numba
+
+from .config import JIT
+
+#: Options of every entry (``config.JIT``: cached, no fastmath).
+ENTRY_JIT = JIT
+#: Options of every kernel: an entry's without the Python and C entry wrappers.
+KERNEL_JIT = dict(JIT, no_cpython_wrapper=True, no_cfunc_wrapper=True)
+#: Kernels this process has called from Python (each compiled a trampoline, uncached):
+#: production code calls entries only (tests/test_jit.py checks a run, a sweep and the
+#: stability analyses leave this empty).
+TRAMPOLINES = []
+
+
+def entry(function):
+    """Compile ``function`` as an entry point: callable from Python and from jitted code."""
+    return numba.njit(**ENTRY_JIT)(function)
+
+
+class Kernel:
+    """A wrapper-less dispatcher (``dispatcher``) that jitted code calls directly and
+    Python through a trampoline; other attributes (``py_func``, ``signatures``,
+    ``inspect_llvm``...) are the dispatcher's."""
+
+    def __init__(self, function):
+        self.dispatcher = numba.njit(**KERNEL_JIT)(function)
+        self._from_python = None
+        functools.update_wrapper(self, function)
+
+    @property
+    def _numba_type_(self):
+        return self.dispatcher._numba_type_
+
+    def __call__(self, *args):
+        if self._from_python is None:
+            TRAMPOLINES.append(f"{self.__module__}.{self.__qualname__}")
+            target = self.dispatcher
+            self._from_python = numba.njit(nogil=True, error_model="numpy")(
+                lambda *arguments: target(*arguments))
+        return self._from_python(*args)
+
+    def __getattr__(self, name):
+        if name == "dispatcher":  # not yet set: during unpickling or __init__
+            raise AttributeError(name)
+        return getattr(self.dispatcher, name)
+
+    def __reduce__(self):
+        return _kernel_by_name, (self.__module__, self.__qualname__)
+
+    def __repr__(self):
+        return f"<loopsim kernel {self.__module__}.{self.__qualname__}>"
+
+
+def _kernel_by_name(module, qualname):
+    import importlib
+
+    found = importlib.import_module(module)
+    for part in qualname.split("."):
+        found = getattr(found, part)
+    return found
+
+
+def kernel(function):
+    """Compile ``function`` as a kernel: called from jitted code (from Python only in tests
+    and interactive use, through a trampoline)."""
+    return Kernel(function)
