@@ -7,7 +7,9 @@ A new model (say, nonlocal hydrodynamics) is one module implementing the
 interface, imported here so its implementations are registered.
 """
 
-from ..jit import entry, kernel
+import numpy as np
+
+from ..jit import entry
 from . import local_sbt, riccati  # noqa: F401 - importing registers the implementations
 from .base import (
     auxiliary, constraint_error, for_case, implements, jacobian, resolution_error,
@@ -17,7 +19,7 @@ from .base import (
 __all__ = ["rhs", "jacobian", "constraint_error", "resolution_error", "resolution_size",
            "steady_invariants",
            "auxiliary",
-           "for_case", "implements", "evaluate", "local_sbt", "riccati"]
+           "for_case", "implements", "evaluate", "evaluate_jacobian", "local_sbt", "riccati"]
 
 
 @entry
@@ -25,3 +27,11 @@ def evaluate(problem, y, dydt, aux):
     """dydt = F(y) and the model's auxiliary field at y (the tension multiplier of a loop)."""
     rhs(problem, y, dydt)
     auxiliary(problem, aux)
+
+
+@entry
+def evaluate_jacobian(problem, y, jac):
+    """jac = ∂F/∂y at y (the model's :func:`jacobian`, after the F(y) it is given)."""
+    f = np.empty_like(y)
+    rhs(problem, y, f)
+    jacobian(problem, y, f, jac, np.empty_like(y), np.empty_like(y))

@@ -1,11 +1,11 @@
 """The exact Jacobian of the local model's velocity (``loop_maps.loop_velocity``)."""
 import numpy as np
 
-from ..jit import entry
+from ..jit import kernel
 from .loop_maps import loop_velocity_blocks
 
 
-@entry  # also called from Python, by the stability analyses (stability.circle, .steady)
+@kernel
 def loop_jacobian(x, g0, w, ops, ws, jac):
     """Exact Jacobian J = ∂u/∂x (3K × 3K, component-major) of :func:`loop_velocity`.
 

@@ -218,7 +218,7 @@ def length_rate_operator(g0, w, ops, ws):
                 - w * (1.0 - stretch))
 
 
-@entry  # also called from Python, by the steady-branch analysis (stability.steady)
+@kernel
 def loop_velocity(x, g0, w, ops, ws, u_out):
     """Velocity coefficients u (3, K) of the shape x (3, K); tension left in ws.tension.
 

@@ -61,7 +61,7 @@ import math
 
 import numpy as np
 
-from .. import spectral, validation
+from .. import models, spectral, validation
 from ..config import DEFAULT_W
 from ..models import local_sbt
 from ..shapes import inclined_circle
@@ -115,7 +115,7 @@ def rhs_jacobian(x, g0, w=DEFAULT_W):
     n = (x.shape[1] - 1) // 2
     problem = local_sbt.make_problem(n, g0, w, local_sbt.make_operators(n))
     jac = np.empty((x.size, x.size))
-    local_sbt.loop_jacobian(x, problem.g0, problem.w, problem.ops, problem.ws, jac)
+    models.evaluate_jacobian(problem, x.reshape(-1), jac)
     return jac
 
 

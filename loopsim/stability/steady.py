@@ -46,7 +46,7 @@ import math
 
 import numpy as np
 
-from .. import diagnostics, spectral
+from .. import diagnostics, models, spectral
 from ..config import DEFAULT_W
 from ..models import local_sbt
 from .circle import l2_weights
@@ -74,8 +74,11 @@ def planar_state(n, x_plane):
 
 
 def steady_velocity(x, g0, w, problem):
+    """u = F(x) (3, K) at gravity g0 and penalty w, on ``problem``'s operators."""
+    x = np.ascontiguousarray(x, dtype=float)
     u = np.empty_like(x)
-    local_sbt.loop_velocity(x, g0, w, problem.ops, problem.ws, u)
+    models.evaluate(problem._replace(g0=float(g0), w=float(w)), x.reshape(-1), u.reshape(-1),
+                    np.empty(x.shape[1]))
     return u
 
 
@@ -90,8 +93,10 @@ def steady_residual(x, velocity, slide, q, w=DEFAULT_W):
 
 
 def velocity_jacobian(x, g0, w, problem):
+    """∂F/∂x (3K, 3K, component-major) at x, as :func:`steady_velocity`."""
+    x = np.ascontiguousarray(x, dtype=float)
     jac = np.empty((x.size, x.size))
-    local_sbt.loop_jacobian(x, g0, w, problem.ops, problem.ws, jac)
+    models.evaluate_jacobian(problem._replace(g0=float(g0), w=float(w)), x.reshape(-1), jac)
     return jac
 
 
