@@ -23,16 +23,16 @@ import numba
 import numpy as np
 
 import loopsim
-from loopsim import linalg, spectral
+from loopsim import linalg, models, spectral
 from loopsim.integrators import radau
-from loopsim.models import local_sbt
+from loopsim.models import local_sbt, rhs
 from scaling import per_call  # best of three timed loops, µs per call
 
 
 @numba.njit(cache=True)
-def _rhs(x, g0, w, ops, ws, u, repeats):
+def _rhs(problem, y, dydt, repeats):
     for _ in range(repeats):
-        local_sbt.loop_velocity(x, g0, w, ops, ws, u)
+        rhs(problem, y, dydt)
 
 
 @numba.njit(cache=True)
@@ -68,14 +68,16 @@ def main():
         ops, ws = local_sbt.make_operators(n), local_sbt.make_workspace(n)
         d = 3 * (2 * n + 1)
         u, u_blocks, jac = np.empty_like(x), np.empty_like(x), np.empty((d, d))
-        local_sbt.loop_velocity(x, g0, w, ops, ws, u)
+        models.evaluate(local_sbt.LoopProblem(g0, w, ops, ws), x.reshape(-1), u.reshape(-1),
+                        np.empty(x.shape[1]))
         local_sbt.loop_velocity_blocks(x, g0, w, ops, ws, u_blocks)
         local_sbt.loop_jacobian(x, g0, w, ops, ws, jac)
         max_du = float(np.abs(u - u_blocks).max() / np.abs(u_blocks).max())
         repeats = max(20, int(3e6 / n**3))
         row = dict(
             n=n,
-            rhs_us=per_call(_rhs, (x, g0, w, ops, ws, u), repeats),
+            rhs_us=per_call(_rhs, (local_sbt.LoopProblem(g0, w, ops, ws), x.reshape(-1),
+                                      u.reshape(-1)), repeats),
             rhs_blocks_us=per_call(_rhs_blocks, (x, g0, w, ops, ws, u), repeats),
             jacobian_us=per_call(_jacobian, (x, g0, w, ops, ws, jac), max(5, repeats // 8)),
             newton_lu_us=per_call(_newton_lu, (

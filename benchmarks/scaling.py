@@ -20,7 +20,7 @@ import numba
 import numpy as np
 
 import loopsim
-from loopsim import shapes
+from loopsim import models, shapes
 from loopsim.linalg import least_squares_normal
 from loopsim.models import local_sbt as physics
 
@@ -40,9 +40,9 @@ def _time_solve(ops, ws, repeats):
 
 
 @numba.njit(cache=True)
-def _time_rhs(x, g0, w, ops, ws, u, repeats):
+def _time_rhs(problem, y, dydt, repeats):
     for _ in range(repeats):
-        physics.loop_velocity(x, g0, w, ops, ws, u)
+        models.rhs(problem, y, dydt)
 
 
 def per_call(fn, args, repeats):
@@ -72,7 +72,7 @@ def main():
         ops, ws = problem.ops, problem.ws
         u = np.empty_like(x)
         repeats = max(200, int(2e5 / n**3))
-        rhs = per_call(_time_rhs, (x, g0, w, ops, ws, u), repeats)
+        rhs = per_call(_time_rhs, (problem, x.reshape(-1), u.reshape(-1)), repeats)
         maps = per_call(_time_maps, (x, g0, w, ops, ws), repeats)
         physics.shape_on_grid(x, ops, ws)
         physics.length_rate_operator(g0, w, ops, ws)

@@ -3,9 +3,15 @@ import numpy as np
 import pytest
 
 import naive
-from loopsim import api, shapes
+from loopsim import api, models, shapes
 from loopsim.linalg import least_squares_affine, least_squares_normal
 from loopsim.models import local_sbt as physics
+
+
+def _velocity(x, g0, w, ops, ws, u):
+    """u = F(x) (3, K) through the compiled entry (``models.evaluate``)."""
+    models.evaluate(physics.LoopProblem(g0, w, ops, ws), x.reshape(-1), u.reshape(-1),
+                    np.empty(x.shape[1]))
 
 
 def translating_circle(g0, theta):
@@ -96,7 +102,7 @@ def test_fast_velocity_equals_the_block_path(n, rng):
     ops = physics.make_operators(n)
     ws = physics.make_workspace(n)
     u_fast, u_blocks = np.empty_like(x), np.empty_like(x)
-    physics.loop_velocity(x, 120.0, 10.0, ops, ws, u_fast)
+    _velocity(x, 120.0, 10.0, ops, ws, u_fast)
     tension_fast = ws.tension.copy()
     physics.loop_velocity_blocks(x, 120.0, 10.0, ops, ws, u_blocks)
     np.testing.assert_allclose(u_fast, u_blocks, rtol=0, atol=1e-11 * np.abs(u_blocks).max())
@@ -200,7 +206,7 @@ def test_exact_jacobian_against_finite_differences_and_numpy_twin(n, rng):
     for col in range(x.size):
         step = np.zeros(x.size)
         step[col] = h
-        physics.loop_velocity(x + step.reshape(x.shape), 70.0, 10.0, problem.ops, problem.ws, up)
-        physics.loop_velocity(x - step.reshape(x.shape), 70.0, 10.0, problem.ops, problem.ws, um)
+        _velocity(x + step.reshape(x.shape), 70.0, 10.0, problem.ops, problem.ws, up)
+        _velocity(x - step.reshape(x.shape), 70.0, 10.0, problem.ops, problem.ws, um)
         fd[:, col] = ((up - um) / (2 * h)).ravel()
     assert np.abs(jac - fd).max() < 1e-6 * scale  # central differences: O(h²) + round-off

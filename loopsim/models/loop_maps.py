@@ -218,14 +218,27 @@ def length_rate_operator(g0, w, ops, ws):
                 - w * (1.0 - stretch))
 
 
-@kernel
-def loop_velocity(x, g0, w, ops, ws, u_out):
-    """Velocity coefficients u (3, K) of the shape x (3, K); tension left in ws.tension.
+def loop_velocity(problem, y, dydt):
+    """dydt = u.ravel(), the velocity coefficients u (3, K) of the shape x = y.reshape(3, K)
+    of a loop ``problem`` (fields g0, w, ops, ws: a ``local_sbt.LoopProblem``); the
+    tension is left in problem.ws.tension.
 
     u_c = F m_c, m_c = f_c + (t·f) t_c, f_c = P1(t_c T) − x⁗_c − g0 δ_cz, with T the
     least-squares tension of :func:`length_rate_operator`: the same map as
     :func:`loop_velocity_blocks`, at about half the flops.
+
+    Not decorated: it is compiled as the local model's ``rhs`` implementation
+    (``local_sbt``), holding its code itself rather than calling a kernel that does, so
+    a run compiles the velocity's code in one library fewer (docs/performance.md,
+    "Compilation").  From Python: ``models.evaluate``.
     """
+    g0 = problem.g0
+    w = problem.w
+    ops = problem.ops
+    ws = problem.ws
+    k = y.shape[0] // 3
+    x = y.reshape((3, k))
+    u_out = dydt.reshape((3, k))
     m = ops.m
     shape_on_grid(x, ops, ws)
     length_rate_operator(g0, w, ops, ws)
