@@ -35,6 +35,20 @@ def test_fehlberg_tableau_is_consistent():
 
 
 @pytest.mark.parametrize("name, method", METHODS)
+def test_a_run_without_output_times_takes_the_same_steps(name, method):
+    """t_out = y_out = None compiles the driver without its output code: the end state
+    and every count are those of the run asked for output inside the steps."""
+    (status, t, y, counts, worst), y_out = run(method, 0.9, np.linspace(0.0, 0.9, 7))
+    options = I.step_options(1e-8, 1e-10, None, 0.0, np.inf, 100_000)
+    bare = I.integrate(method, riccati.RiccatiProblem(RATES), Y0, 0.0, 0.9, None, options, None)
+    assert (bare[0], bare[1]) == (status, t)
+    np.testing.assert_array_equal(bare[2], y)
+    np.testing.assert_array_equal(bare[3], counts)
+    np.testing.assert_array_equal(bare[4], worst)
+    np.testing.assert_array_equal(y_out[-1], y)
+
+
+@pytest.mark.parametrize("name, method", METHODS)
 def test_adaptive_run_meets_tolerance_at_output_times(name, method):
     t_out = np.linspace(0.0, 0.9, 7)
     (status, t, y, counts, _), y_out = run(method, 0.9, t_out)

@@ -168,13 +168,19 @@ def initial_step(y0, f0, f1, h0, f0_norm, rtol, atol, error_order, h_max):
 
 # ---- output times and monitors ----------------------------------------------
 @kernel
-def record_start(problem, y, t0, t_out, y_out, options):
-    """Outputs at t0 and the initial monitor state (i_out, next_check, invariants, quiet)."""
+def outputs_at_start(y, t0, t_out, y_out):
+    """y_out[i] = y for the output times t_out[i] <= t0; returns the next output's index."""
     i_out = 0
     while i_out < t_out.shape[0] and t_out[i_out] <= t0:
         copy_into(y_out[i_out], y)
         i_out += 1
-    return i_out, t0 + options.steady_interval, steady_invariants(problem, y), np.int64(0)
+    return i_out
+
+
+@kernel
+def monitor_start(problem, y, t0, options):
+    """The steady-state monitor's start: (next_check, invariants, quiet)."""
+    return t0 + options.steady_interval, steady_invariants(problem, y), np.int64(0)
 
 
 @kernel

@@ -18,7 +18,7 @@ from ..models import rhs
 from .base import advance, attempt, dense_output, start, statistics
 from .control import (
     NON_FINITE, OK, all_finite, initial_step, initial_step_probe, initial_worst, landing, monitor,
-    record_start, stop_check,
+    monitor_start, outputs_at_start, stop_check,
 )
 
 
@@ -45,7 +45,9 @@ def integrate(method, problem, y0, t0, t_end, t_out, options, y_out):
 
     t_out: sorted output times in [t0, t_end]; the state at t_out[i] is written
     to y_out[i] (exactly at t0 and t_end, by the method's dense output between
-    steps).  Rows of y_out for times not reached are left untouched.
+    steps).  Rows of y_out for times not reached are left untouched.  t_out = y_out =
+    None: no output (the end state is returned), and Numba compiles this call without
+    the output code, dense output included (the sweeps' and plain runs' case).
 
     Returns (status, t, y, counts, worst): counts (int64) = [accepted steps,
     rejected steps, RHS evaluations of the steps (dense output's are not counted), Jacobian
@@ -72,7 +74,10 @@ def integrate(method, problem, y0, t0, t_end, t_out, options, y_out):
     if not all_finite(f) or not all_finite(y):
         counts[2] = n_rhs
         return NON_FINITE, t, y, counts, worst
-    i_out, next_check, previous, quiet = record_start(problem, y, t0, t_out, y_out, options)
+    i_out = 0
+    if t_out is not None:  # decided at compile time (Numba prunes the branch on None)
+        i_out = outputs_at_start(y, t0, t_out, y_out)
+    next_check, previous, quiet = monitor_start(problem, y, t0, options)
     work, evals = start(method, problem, y, f, options)
     n_rhs += evals
     if options.first_step > 0.0:
@@ -104,14 +109,16 @@ def integrate(method, problem, y0, t0, t_end, t_out, options, y_out):
         n_rhs += 1
         if not all_finite(f):
             return NON_FINITE, t, y, _counts(method, work, counts, n_acc, n_rej, n_rhs), worst
-        while i_out < t_out.shape[0] and t_out[i_out] <= t:
-            if t_out[i_out] == t:
-                copy_into(y_out[i_out], y)
-            else:  # its evaluations are output's, not the step's: not in nfev, so asking
-                # for output changes no count (a sweep's traced rows equal the others)
-                dense_output(method, work, problem, y_old, f_old, y, f, h_try,
-                             (t_out[i_out] - t_old) / h_try, y_out[i_out], options)
-            i_out += 1
+        if t_out is not None:
+            while i_out < t_out.shape[0] and t_out[i_out] <= t:
+                if t_out[i_out] == t:
+                    copy_into(y_out[i_out], y)
+                else:  # its evaluations are output's, not the step's: not in nfev, so
+                    # asking for output changes no count (a sweep's traced rows equal
+                    # the others)
+                    dense_output(method, work, problem, y_old, f_old, y, f, h_try,
+                                 (t_out[i_out] - t_old) / h_try, y_out[i_out], options)
+                i_out += 1
         stop, next_check, previous, quiet = monitor(
             problem, t, y, t_end, options, worst, next_check, previous, quiet)
         if stop >= 0:
