@@ -32,11 +32,8 @@ The steps (the runs), with the figures that need them:
 * ``g60_t30_n16``: the in-plane loop g0 = 60, θ0 = 30°, n = 16 (radau5):
   fig1_tension_g60_t30_n16;
 * ``main_job``: the README's main job, its exact command (72 loops at ``--n auto``,
-  with twins) into ``runs/phase``: phase_main;
-* ``phase_auto``: the 225-loop grid with ``--n auto --method auto`` (rtol 1e-6):
-  phase_auto, fig7_q_tilt_phase_auto, fig8_aspect_phase_auto.  Hours on 2 cores.  The
-  committed ones were computed with the earlier ``--n auto`` (docs/earlier-n-auto.md);
-  a rerun draws today's, whose numbers differ from that page's;
+  with twins) into ``runs/phase``: phase_main, fig7_q_tilt_main, fig8_aspect_main (Figs.
+  7 and 8 of a resolved grid);
 * ``seeds_auto_study``: docs/distributions.md's study, ``--seeds auto`` (at most 32) at
   ``--n auto`` with twins over g0 = 30, 60, 100 x θ0 = 30, 60°: seeds_auto_study
   (``loopsim summary --figure``; ``scripts/distribution_study.py`` runs the same sweep
@@ -155,8 +152,6 @@ def steps(runs, threads, quick=False, n24=False):
         sweep("phase", *main_job, *auto_quick, capped=True),
         sweep("seed_cells", "--g0", "100,150", "--theta0", "45,60", "--seeds", seeds_cells,
               "--n", "auto", *auto_quick, capped=True),
-        sweep("phase_auto", *grid, "--n", "auto", "--method", "auto", *auto_quick, *lean,
-              capped=True),
         sweep("seeds_auto_study", "--g0", "30,60,100", "--theta0", "30,60", "--seeds", "auto",
               "--max-seeds", "4" if quick else "32", "--n", "auto", *auto_quick, capped=True),
     ])
@@ -186,16 +181,13 @@ def targets(quick=False):
         "fig6_evolution": (runs3, ("figures", "seeds_n6", runs3, "evolution", "fig6_evolution")),
         "fig7_q_tilt": (["phase_n6", "resolved_auto"],
                         ("figures", "phase_n6", ["resolved_auto"], "q_tilt", "fig7_q_tilt")),
-        "fig7_q_tilt_phase_auto": (["phase_auto"],
-                                   ("figures", "phase_auto", [], "q_tilt", "fig7_q_tilt")),
+        "fig7_q_tilt_main": (["main_job"], ("figures", "main_job", [], "q_tilt", "fig7_q_tilt")),
         "fig8_aspect": (["phase_n6", "resolved_auto"],
                         ("figures", "phase_n6", ["resolved_auto"], "aspect", "fig8_aspect")),
-        "fig8_aspect_phase_auto": (["phase_auto"],
-                                   ("figures", "phase_auto", [], "aspect", "fig8_aspect")),
+        "fig8_aspect_main": (["main_job"], ("figures", "main_job", [], "aspect", "fig8_aspect")),
         "fig9_phase_n": (["phase_n4", "phase_n8"],
                          ("figures", "phase_n6", ["phase_n4", "phase_n8"], "phase_n",
                           "fig9_phase_n")),
-        "phase_auto": (["phase_auto"], ("phase", "phase_auto")),
         "phase_main": (["main_job"], ("phase", "main_job")),
         "phase_n6": (["phase_n6"], ("phase", "phase_n6")),
         "seed_cells": (["seed_cells"], ("summary", "seed_cells")),
