@@ -1,0 +1,70 @@
+"""The compiled kernels of the nonlocal operator (``models.nonlocal_maps``) against its
+plain-NumPy reference (``models.nonlocal_operator``), which is tested against closed forms
+and adaptive quadrature in tests/test_nonlocal_operator.py."""
+import numpy as np
+import pytest
+
+from loopsim import spectral
+from loopsim.models import nonlocal_maps, nonlocal_operator as nl
+
+
+def perturbed_loop(n):
+    """A non-circular, non-planar loop parametrised by arc length (length 2π), order n."""
+    raw = np.zeros((3, 7))
+    raw[0, 1], raw[0, 3] = 1.05, 0.05
+    raw[1, 4], raw[1, 6] = 0.95, 0.05
+    raw[2, 6] = 0.1
+    return nl.arclength_parametrised(raw, n)
+
+
+def compiled_geometry(x, m):
+    n = spectral.order_of(x.shape[1])
+    position = np.ascontiguousarray(x @ spectral.synthesis_matrix(n, m).T)
+    tangent = np.ascontiguousarray(x @ spectral.synthesis_matrix(n, m, 1).T)
+    weight, direction = np.empty((m, m)), np.empty((3, m, m))
+    nonlocal_maps.kernel_geometry(position, tangent, nl.singular_weights(m), weight, direction)
+    return tangent, weight, direction
+
+
+@pytest.mark.parametrize("n, m", [(12, 97), (16, 128), (20, 160)])
+def test_kernel_geometry_matches_the_reference(n, m):
+    x = perturbed_loop(n)
+    tangent, weight, direction = compiled_geometry(x, m)
+    ref_tangent, ref_weight, ref_direction = nl.kernel_geometry(x, m)
+    np.testing.assert_allclose(tangent, ref_tangent, rtol=0, atol=1e-14)
+    np.testing.assert_allclose(weight, ref_weight, rtol=1e-13, atol=1e-13 * np.abs(ref_weight).max())
+    np.testing.assert_allclose(direction, ref_direction, rtol=0, atol=1e-13)
+
+
+@pytest.mark.parametrize("n, m", [(12, 97), (16, 128)])
+def test_apply_kernel_matches_the_reference_operator(n, m, rng):
+    x = perturbed_loop(n)
+    force = rng.standard_normal((3, m))
+    _, weight, direction = compiled_geometry(x, m)
+    out = np.empty((3, m))
+    nonlocal_maps.apply_kernel(weight, direction, force, out)
+    reference = nl.K_operator(x, force, m, f_on_grid=True)
+    assert np.abs(out - reference).max() < 1e-12 * np.abs(reference).max()
+
+
+def test_apply_kernel_is_linear_and_sees_a_shift_along_the_grid(rng):
+    """K[a f + b g] = a K[f] + b K[g]; a loop whose start moves by j grid points gives the
+    same values, rolled by j (the closed-loop form has no preferred s = 0)."""
+    n, m, j = 12, 100, 23
+    x = perturbed_loop(n)
+    f, g = rng.standard_normal((2, 3, m))
+    _, weight, direction = compiled_geometry(x, m)
+    kf, kg, kfg = (np.empty((3, m)) for _ in range(3))
+    nonlocal_maps.apply_kernel(weight, direction, f, kf)
+    nonlocal_maps.apply_kernel(weight, direction, g, kg)
+    nonlocal_maps.apply_kernel(weight, direction, 2.0 * f - 0.5 * g, kfg)
+    assert np.abs(kfg - (2.0 * kf - 0.5 * kg)).max() < 1e-12 * np.abs(kfg).max()
+    k = np.arange(1, n + 1)
+    s0 = 2 * np.pi * j / m
+    moved = x.copy()
+    moved[:, 1:n + 1] = x[:, 1:n + 1] * np.cos(k * s0) + x[:, n + 1:] * np.sin(k * s0)
+    moved[:, n + 1:] = x[:, n + 1:] * np.cos(k * s0) - x[:, 1:n + 1] * np.sin(k * s0)
+    _, weight_moved, direction_moved = compiled_geometry(moved, m)
+    out = np.empty((3, m))
+    nonlocal_maps.apply_kernel(weight_moved, direction_moved, np.roll(f, -j, axis=1), out)
+    assert np.abs(out - np.roll(kf, -j, axis=1)).max() < 1e-11 * np.abs(kf).max()
