@@ -168,6 +168,13 @@ def test_progress_goes_to_a_log_file_with_a_cost_weighted_eta(monkeypatch):
     q0 = 150.0 * 3**0.5 / 2 / 3  # --n auto: (q0 / 11)^4 times a stable case
     assert sweeps.case_weight(loop_3d, n_auto=True) == pytest.approx(
         (q0 / 11.0) ** 4 * sweeps.case_weight(stable, n_auto=True), rel=1e-12)
+    early = stdio.StringIO()  # one cheap case of a costly run: no ETA extrapolated from it
+    clock = iter([0.0, 10.0, 10.0, 10.0, 20.0, 20.0, 20.0, 20.0])
+    progress = sweeps.Progress({0: 1.0, 1: 1000.0}, [], stream=early, interval=0.0)
+    progress.update([0], 0)
+    assert "ETA ? " in early.getvalue(), early.getvalue()
+    progress.update([1], 0)
+    assert "ETA 0h00m00s" in early.getvalue().splitlines()[-1]
     quiet = stdio.StringIO()
     progress = sweeps.Progress(weights, [], quiet=True, stream=quiet, interval=0.0)
     progress.update([0], 0)

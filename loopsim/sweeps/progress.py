@@ -12,6 +12,10 @@ from .. import _jitcache, diagnostics
 #: grid (radau5, rtol 1e-6, t = 10): exponent 3.95, and 0.058 s × (q0 / 11)^3.95 meets the
 #: cheap cases' median, 0.066 s, at q0 = 11 (docs/earlier-n-auto.md).
 AUTO_COST_EXPONENT = 4.0
+#: The ETA is shown ("?" before) once the finished cases carry this share of the run's
+#: estimated cost: extrapolated from one cheap case it was 10x off (32 min for the
+#: README's 3-minute main job).
+ETA_MIN_SHARE = 0.01
 
 
 def case_weight(case, n_auto=False):
@@ -36,8 +40,8 @@ def _duration(seconds):
 class Progress:
     """Progress on stderr: a live line in a terminal; in a log file (not a TTY) one line
     every ``interval`` seconds, and a last one at the end.  Done/total, rate, ETA weighted
-    by :func:`case_weight` (both from the time worked: kernel compilation left out),
-    failures.  ``quiet``: nothing."""
+    by :func:`case_weight` (both from the time worked: kernel compilation left out; the
+    ETA "?" until ``ETA_MIN_SHARE`` of the cost is done), failures.  ``quiet``: nothing."""
 
     def __init__(self, weights, done_ids, quiet=False, stream=None, interval=30.0):
         self.stream = sys.stderr if stream is None else stream
@@ -72,8 +76,9 @@ class Progress:
         elapsed = time.perf_counter() - self.start
         working = max(elapsed - (_jitcache.compile_seconds() - self.compiled), 1e-9)
         rate = self.cases_run / working
-        eta = (working * max(self.weight_left, 0.0) / self.weight_run if self.weight_run
-               else math.nan)
+        share = self.weight_run / max(self.weight_run + self.weight_left, 1e-300)
+        eta = (working * max(self.weight_left, 0.0) / self.weight_run
+               if self.weight_run > 0.0 and share >= ETA_MIN_SHARE else math.nan)
         return (f"cases {self.done}/{self.total} ({100 * self.done / max(self.total, 1):3.0f}%) "
                 f"{rate:6.2f} case/s elapsed {_duration(elapsed)} ETA {_duration(eta)} "
                 f"failures {self.failures}")
