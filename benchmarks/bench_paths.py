@@ -23,8 +23,8 @@ import numpy as np
 import loopsim
 from loopsim import integrators, shapes
 from loopsim.integrators.driver import integrate
-from loopsim.models import (auxiliary, constraint_error, implements, jacobian, local_sbt,
-                            resolution_error, rhs, steady_invariants)
+from loopsim.models import (auxiliary, implements, jacobian, local_sbt, monitored_errors, rhs,
+                            steady_invariants)
 
 #: The previous dense path as its own model type (same fields as LoopProblem).
 DenseLoopProblem = collections.namedtuple("DenseLoopProblem", local_sbt.LoopProblem._fields)
@@ -45,16 +45,11 @@ def _dense_jacobian(problem, y, f, jac, work_y, work_f):
     return 1
 
 
-@implements(constraint_error, DenseLoopProblem)
-def _dense_length_error(problem, y):
-    k = y.shape[0] // 3
-    return local_sbt.relative_length_error(y.reshape((3, k)), problem.ops, problem.ws)
-
-
-@implements(resolution_error, DenseLoopProblem)
-def _dense_tail(problem, y):
-    k = y.shape[0] // 3
-    return local_sbt.spectral_tail(y.reshape((3, k)))
+@implements(monitored_errors, DenseLoopProblem)
+def _dense_errors(problem, y):
+    x = y.reshape((3, y.shape[0] // 3))
+    return (local_sbt.relative_length_error(x, problem.ops, problem.ws),
+            local_sbt.spectral_tail(x), local_sbt.top_mode_share(x))
 
 
 @implements(steady_invariants, DenseLoopProblem)

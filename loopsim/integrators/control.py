@@ -17,7 +17,7 @@ import numpy as np
 
 from ..jit import kernel
 from ..linalg import copy_into
-from ..models import constraint_error, resolution_error, resolution_size, steady_invariants
+from ..models import monitored_errors, steady_invariants
 
 # ---- status codes: the driver never raises; a run ends with one of these ----
 OK = 0
@@ -189,7 +189,7 @@ def initial_worst(problem, y):
     (the start's is the user's), no resolution error counted yet, the start's
     resolution size as the previous one, not rising."""
     worst = np.zeros(4)
-    worst[2] = resolution_size(problem, y)
+    worst[2] = monitored_errors(problem, y)[2]
     return worst
 
 
@@ -214,15 +214,14 @@ def monitor(problem, t, y, t_end, options, worst, next_check, previous, quiet):
     error once rising, the previous resolution size, rising (0 or 1)].  REFINE
     comes as soon as the resolution error passes ``options.resolution_tol``; the
     *record* counts it only from the first accepted step at which its absolute size
-    (``models.resolution_size``) grew, since the decay of a start's own seeded high
+    (``models.monitored_errors``) grew, since the decay of a start's own seeded high
     modes is the initial condition, not dynamics that outgrew the truncation.  Returns (status or -1 to go on,
     next_check, previous, quiet).
     """
-    worst[0] = max(worst[0], abs(constraint_error(problem, y)))
+    constraint, resolution, size = monitored_errors(problem, y)
+    worst[0] = max(worst[0], abs(constraint))
     if worst[0] > options.constraint_tol:
         return LENGTH_ERROR, next_check, previous, quiet
-    resolution = resolution_error(problem, y)
-    size = resolution_size(problem, y)
     if size > worst[2]:
         worst[3] = 1.0
     worst[2] = size

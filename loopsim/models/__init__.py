@@ -12,11 +12,10 @@ import numpy as np
 from ..jit import entry
 from . import local_sbt, riccati  # noqa: F401 - importing registers the implementations
 from .base import (
-    auxiliary, constraint_error, for_case, implements, jacobian, resolution_error,
-    resolution_size, rhs, steady_invariants,
+    auxiliary, for_case, implements, jacobian, monitored_errors, rhs, steady_invariants,
 )
 
-__all__ = ["rhs", "jacobian", "constraint_error", "resolution_error", "resolution_size",
+__all__ = ["rhs", "jacobian", "monitored_errors",
            "steady_invariants",
            "auxiliary",
            "for_case", "implements", "evaluate", "evaluate_jacobian", "local_sbt", "riccati"]

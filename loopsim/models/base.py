@@ -25,25 +25,21 @@ def jacobian(problem, y, f, jac, work_y, work_f):
 
 
 @generic
-def constraint_error(problem, y):
-    """The invariant the driver monitors (for a loop: the relative length error)."""
-    raise NotImplementedError("only callable from jitted code")
+def monitored_errors(problem, y):
+    """What the driver monitors after each accepted step, as (constraint_error,
+    resolution_error, resolution_size):
 
+    * constraint_error: the invariant's error (for a loop: the relative length error);
+    * resolution_error: how close the state is to the model's resolution limit (for a
+      loop: the spectral tail, the share of its deformation in its top two Fourier
+      modes); 0 for a model without a truncation;
+    * resolution_size: the absolute size of what resolution_error measures (for a loop:
+      the top modes' RMS amplitude relative to the loop's size): while it shrinks, the
+      top modes are the start's own, decaying, and the driver does not count the error;
+      0 for a model without a truncation.
 
-@generic
-def resolution_error(problem, y):
-    """How close the state is to the model's resolution limit (for a loop: the spectral
-    tail, the share of its deformation in its top two Fourier modes); 0 for a model
-    without a truncation."""
-    raise NotImplementedError("only callable from jitted code")
-
-
-@generic
-def resolution_size(problem, y):
-    """The absolute size of what :func:`resolution_error` measures (for a loop: the top
-    modes' RMS amplitude relative to the loop's size): while it shrinks, the top modes
-    are the start's own, decaying, and the driver does not count the error; 0 for a
-    model without a truncation."""
+    One generic for the three: each implementation taking the problem is a compiled
+    library of its own (docs/performance.md, "Compilation")."""
     raise NotImplementedError("only callable from jitted code")
 
 

@@ -10,8 +10,7 @@ import collections
 
 from ..linalg import copy_into
 from .base import (
-    auxiliary, constraint_error, for_case, implements, jacobian, resolution_error,
-    resolution_size, rhs, steady_invariants,
+    auxiliary, for_case, implements, jacobian, monitored_errors, rhs, steady_invariants,
 )
 from .loop_jacobian import loop_jacobian
 from .loop_maps import (  # noqa: F401 - re-exported
@@ -51,22 +50,11 @@ def _loop_jacobian(problem, y, f, jac, work_y, work_f):
     return 1  # one velocity evaluation inside
 
 
-@implements(constraint_error, LoopProblem)
-def _loop_length_error(problem, y):
-    k = y.shape[0] // 3
-    return relative_length_error(y.reshape((3, k)), problem.ops, problem.ws)
-
-
-@implements(resolution_error, LoopProblem)
-def _loop_tail(problem, y):
-    k = y.shape[0] // 3
-    return spectral_tail(y.reshape((3, k)))
-
-
-@implements(resolution_size, LoopProblem)
-def _loop_top_share(problem, y):
-    k = y.shape[0] // 3
-    return top_mode_share(y.reshape((3, k)))
+@implements(monitored_errors, LoopProblem)
+def _loop_errors(problem, y):
+    x = y.reshape((3, y.shape[0] // 3))
+    return (relative_length_error(x, problem.ops, problem.ws), spectral_tail(x),
+            top_mode_share(x))
 
 
 @implements(steady_invariants, LoopProblem)

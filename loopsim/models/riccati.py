@@ -7,8 +7,7 @@ statuses of every registered integrator.
 import collections
 
 from .base import (
-    auxiliary, constraint_error, for_case, implements, jacobian, resolution_error,
-    resolution_size, rhs, steady_invariants,
+    auxiliary, for_case, implements, jacobian, monitored_errors, rhs, steady_invariants,
 )
 
 RiccatiProblem = collections.namedtuple("RiccatiProblem", "rates")
@@ -34,19 +33,9 @@ def _riccati_jacobian(problem, y, f, jac, work_y, work_f):
     return 0
 
 
-@implements(constraint_error, RiccatiProblem)
-def _no_constraint(problem, y):
-    return 0.0
-
-
-@implements(resolution_error, RiccatiProblem)
-def _no_truncation(problem, y):
-    return 0.0
-
-
-@implements(resolution_size, RiccatiProblem)
-def _no_truncation_size(problem, y):
-    return 0.0
+@implements(monitored_errors, RiccatiProblem)
+def _no_constraint_no_truncation(problem, y):
+    return 0.0, 0.0, 0.0
 
 
 @implements(steady_invariants, RiccatiProblem)
