@@ -32,7 +32,8 @@ def test_kernel_geometry_matches_the_reference(n, m):
     tangent, weight, direction = compiled_geometry(x, m)
     ref_tangent, ref_weight, ref_direction = nl.kernel_geometry(x, m)
     np.testing.assert_allclose(tangent, ref_tangent, rtol=0, atol=1e-14)
-    np.testing.assert_allclose(weight, ref_weight, rtol=1e-13, atol=1e-13 * np.abs(ref_weight).max())
+    np.testing.assert_allclose(weight, ref_weight, rtol=1e-13,
+                               atol=1e-13 * np.abs(ref_weight).max())
     np.testing.assert_allclose(direction, ref_direction, rtol=0, atol=1e-13)
 
 

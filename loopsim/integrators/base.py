@@ -37,7 +37,8 @@ def advance(method, work, problem, y, f, h, h_proposal):
 def dense_output(method, work, problem, y_old, f_old, y, f, h, theta, out, options):
     """out = the state at t_old + theta h (0 < theta < 1) within the accepted step from
     y_old (f_old = F(y_old)) to y (f = F(y)), by the method's dense output (``options``:
-    the run's step options); returns the RHS evaluations it cost.  It must not change what the next step does."""
+    the run's step options); returns the RHS evaluations it cost.  It must not change
+    what the next step does."""
     raise NotImplementedError("only callable from jitted code")
 
 
