@@ -5,9 +5,9 @@ kernel's helpers): a plain ``numba.njit`` dispatcher with its Python entry wrapp
 
 ``@kernel``: a function compiled code calls.  It is compiled *without* the Python
 (``cpython``) and C (``cfunc``) entry wrappers Numba would build by default: for a
-kernel taking a problem namedtuple (some 40 arrays) the wrappers are a fifth of its
-machine code, compiled again in every caller's module, and a cold first run spends
-about a fifth less time compiling without them (docs/performance.md, "Compilation").
+kernel taking a problem namedtuple (some 40 arrays) the wrappers are about a fifth of
+its LLVM IR, and leaving them out took about a fifth off a cold first run's compilation
+(docs/performance.md, "Compilation").
 Jitted callers see the plain dispatcher (``_numba_type_``); a call from Python (tests,
 interactive use) goes through a small uncached trampoline compiled on first use, so
 calling a kernel from Python works, only its first call compiles more than an entry's.
