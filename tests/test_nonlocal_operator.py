@@ -423,3 +423,52 @@ def test_operator_matches_adaptive_quadrature_off_the_circle(rng):
                 + quad(lambda s: integrand(s, a), 0.0, math.pi) for a in range(3)]
     got = nl.K_operator(x, f, m)[:, j]
     assert np.abs(got - expected).max() < 1e-10  # measured 9e-12, |K| ≈ 7
+
+
+# ---- the elastic loop: tension and velocity ---------------------------------------------------
+
+def test_loop_velocity_with_the_local_mobility_is_loopsims_local_model(rng):
+    """loop_tension_and_velocity with local_matrix against the compiled local model
+    (models.evaluate: its own grid, its own least-squares solver)."""
+    from loopsim import models
+    from loopsim.models import local_sbt
+
+    n, g0, w = 6, 80.0, 10.0
+    x = naive.random_shape(rng, n)
+    tension, u = nl.loop_tension_and_velocity(x, g0, w, nl.local_matrix(x, quadrature_points=64))
+    problem = local_sbt.make_problem(n, g0, w)
+    u_compiled, tension_compiled = np.empty_like(x), np.empty(x.shape[1])
+    models.evaluate(problem, x.reshape(-1).copy(), u_compiled.reshape(-1), tension_compiled)
+    assert np.abs(u - u_compiled).max() < 1e-9 * np.abs(u_compiled).max()
+    assert np.abs(tension - tension_compiled).max() < 1e-9 * np.abs(tension_compiled).max()
+
+
+@pytest.mark.parametrize("eps", EPSILONS)
+def test_horizontal_ring_sediments_as_johnson_wu_broadside(eps):
+    """A horizontal ring under gravity: the tension (−1, cancelling bending) keeps it
+    circular and it translates at Johnson & Wu's broadside velocity, −g0 U_b e_z."""
+    g0 = 3.0
+    x = circle(4)
+    tension, u = nl.nonlocal_loop_velocity(x, g0, 10.0, eps, quadrature_points=64)
+    broadside, _ = nl.johnson_wu_ring(eps)
+    expected = np.zeros_like(u)
+    expected[2, 0] = -g0 * broadside
+    assert np.abs(u - expected).max() < 1e-11
+    assert np.abs(tension - np.eye(1, tension.size)[0] * -1.0).max() < 1e-10
+
+
+def test_loop_velocity_tends_to_the_local_one_as_one_over_c(rng):
+    """u(c) = u_local + u1 / c + O(1/c²): c (u - u_local) converges, its change halving as
+    c doubles (ε = 1e-8 ... 1e-64: c = 36.8, 73.7, 147, 295; at c = 18.4 the ratio is
+    still 2.5)."""
+    x = perturbed_loop(12)
+    g0, w, m = 40.0, 10.0, 128
+    _, u_local = nl.loop_tension_and_velocity(x, g0, w, nl.local_matrix(x, quadrature_points=m))
+    scaled = []
+    for eps in (1e-8, 1e-16, 1e-32, 1e-64):
+        _, u = nl.nonlocal_loop_velocity(x, g0, w, eps, quadrature_points=m)
+        scaled.append(nl.slenderness_constant(eps) * (u - u_local))
+    changes = [np.abs(b - a).max() for a, b in zip(scaled, scaled[1:])]
+    assert np.abs(scaled[-1]).max() > 10 * changes[-1]  # a correction of order 1/c, not 0
+    for previous, current in zip(changes, changes[1:]):
+        assert 1.9 < previous / current < 2.3, changes

@@ -291,6 +291,52 @@ def local_matrix(x, n=None, quadrature_points=None):
     return _coefficient_matrix(np.eye(3 * m) + _tangent_block(x, m), n, m)
 
 
+# ---- the elastic loop: tension and velocity --------------------------------------------------
+
+def loop_tension_and_velocity(x, g0, w, mobility):
+    """The loop model's tension T and velocity u (both order n) for the shape x (3, 2n+1),
+    with u = ``mobility`` applied to the force (a (3K, 3K) coefficient map, K = 2n+1:
+    :func:`nonlocal_matrix` or :func:`local_matrix`):
+
+        f = P_n[ -x'''' + (T x')' - g0 e_z ],   u = mobility f,
+        T = argmin ∫ ε² ds,   ε = x'·u' - w (1 - x'·x'),
+
+    ε on the 4n + 1-point grid (order 2n: its grid sum is the exact L² norm), the least
+    squares dense (``numpy.linalg.lstsq`` on the K tension basis functions): the reference
+    the nonlocal model's compiled tension solve is to be tested against.  With
+    :func:`local_matrix` it is loopsim's local model.  Returns (T (K,), u (3, K)).
+    """
+    x, n = _shape(x)
+    k = spectral.n_coeffs(n)
+    m = 4 * n + 1
+    d = spectral.derivative_matrix(n)
+    synthesis = spectral.synthesis_matrix(n, m)
+    tangent = (x @ d.T) @ synthesis.T
+    bending = -(x @ np.linalg.matrix_power(d, 4).T)
+    bending[2, 0] -= g0
+
+    def length_rate(tension):
+        """(x'·u' on the grid, u) for the tension coefficients ``tension``."""
+        flux = spectral.resize(spectral.fit((tension @ synthesis.T) * tangent), n)
+        u = (mobility @ (bending + flux @ d.T).reshape(-1)).reshape(3, k)
+        return np.sum(tangent * ((u @ d.T) @ synthesis.T), axis=0), u
+
+    stretch = w * (1.0 - np.sum(tangent * tangent, axis=0))
+    affine = length_rate(np.zeros(k))[0] - stretch
+    columns = np.array([length_rate(np.eye(k)[j])[0] - stretch - affine for j in range(k)]).T
+    tension = np.linalg.lstsq(columns, -affine, rcond=None)[0]
+    return tension, length_rate(tension)[1]
+
+
+def nonlocal_loop_velocity(x, g0, w, eps, quadrature_points=None,
+                           arclength_tol=ARCLENGTH_TOL):
+    """(T, u) of the loop in nonlocal slender-body theory at slenderness ε
+    (:func:`loop_tension_and_velocity` with :func:`nonlocal_matrix`)."""
+    return loop_tension_and_velocity(
+        x, g0, w, nonlocal_matrix(x, eps, quadrature_points=quadrature_points,
+                                  arclength_tol=arclength_tol))
+
+
 # ---- rigid loops ---------------------------------------------------------------------------
 
 def _rigid_order(x_order, n):
