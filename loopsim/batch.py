@@ -21,28 +21,28 @@ from .models import for_case
 _PARALLEL_JIT = dict(JIT, parallel=True)
 
 
-@entry  # called from Python too, by one-thread sweeps
-def run_lane(lane, lanes, method, constants, parameters, x0, t0, t_end, options, order, y_final,
-             t_final, status, counts, worst):
-    """Integrate the cases order[lane], order[lane + lanes], ...; case b writes only row b."""
-    for position in range(lane, order.shape[0], lanes):
-        b = order[position]
-        problem = for_case(constants, parameters[b])
-        result = integrate(method, problem, x0[b], t0[b], t_end[b], None, options, None)
-        status[b] = result[0]
-        t_final[b] = result[1]
-        y_final[b] = result[2]
-        counts[b] = result[3]
-        worst[b] = result[4][:2]
+@entry  # called from Python by the serial path
+def case_problem(constants, parameters):
+    """The problem of one case (``models.for_case``)."""
+    return for_case(constants, parameters)
 
 
 @numba.njit(**_PARALLEL_JIT)
 def parallel_cases(method, constants, parameters, x0, t0, t_end, options, order, lanes, y_final,
                    t_final, status, counts, worst):
-    """One lane per thread (``numba.prange``), each running :func:`run_lane`."""
+    """One lane per thread (``numba.prange``): lane l integrates the cases order[l],
+    order[l + lanes], ...; case b writes only row b.  The lane's loop is the prange body
+    itself: no separate lane kernel compiles the model's code once more."""
     for lane in numba.prange(lanes):
-        run_lane(lane, lanes, method, constants, parameters, x0, t0, t_end, options, order,
-                 y_final, t_final, status, counts, worst)
+        for position in range(lane, order.shape[0], lanes):
+            b = order[position]
+            problem = for_case(constants, parameters[b])
+            result = integrate(method, problem, x0[b], t0[b], t_end[b], None, options, None)
+            status[b] = result[0]
+            t_final[b] = result[1]
+            y_final[b] = result[2]
+            counts[b] = result[3]
+            worst[b] = result[4][:2]
 
 
 def integrate_cases(method, constants, parameters, x0, t_end, options, cost=None, lanes=None,
@@ -74,9 +74,14 @@ def integrate_cases(method, constants, parameters, x0, t_end, options, cost=None
     parameters = np.ascontiguousarray(np.asarray(parameters, dtype=float).reshape(cases, -1))
     x0, t0, t_end = np.ascontiguousarray(x0), as_array(t0), as_array(t_end)
     outputs = (y_final, t_final, status, counts, worst)
-    if lanes == 1:  # the serial kernel: Python threads may each run one (the sweep's work
-        # queue), while a parallel kernel is not to be launched from several threads at once
-        run_lane(0, 1, method, constants, parameters, x0, t0, t_end, options, order, *outputs)
+    if lanes == 1:  # serial, case by case: Python threads may each run one (the sweep's
+        # work queue; integrate releases the GIL), while a parallel kernel is not to be
+        # launched from several threads at once
+        for b in order:
+            status[b], t_final[b], y_final[b], counts[b], case_worst = integrate(
+                method, case_problem(constants, parameters[b]), x0[b], t0[b], t_end[b], None,
+                options, None)
+            worst[b] = case_worst[:2]
     else:
         parallel_cases(method, constants, parameters, x0, t0, t_end, options, order, lanes,
                        *outputs)

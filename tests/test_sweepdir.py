@@ -292,10 +292,11 @@ def test_free_workers_go_past_a_slow_case(tmp_path, reference, monkeypatch):
     other computes all five remaining positions (with units of --threads positions and a
     barrier per unit, it would wait for position 0 first).  The table is unchanged.  The
     held worker waits in Python; the kernels let two workers compute at once because
-    they release the GIL (nogil), checked on the kernel the workers call."""
-    from loopsim import batch
+    they release the GIL (nogil), checked on the kernel the workers call (one-thread
+    batches call ``integrate`` case by case)."""
+    from loopsim import integrators
 
-    assert batch.run_lane.targetoptions.get("nogil") is True
+    assert integrators.integrate.targetoptions.get("nogil") is True
     finished, release = _hold_position(monkeypatch, held=0)
     start = time.monotonic()
     frame = sweeps.run_sweep(config(snapshots_for=[4], snapshot_count=3), str(tmp_path / "q"),
