@@ -472,3 +472,16 @@ def test_loop_velocity_tends_to_the_local_one_as_one_over_c(rng):
     assert np.abs(scaled[-1]).max() > 10 * changes[-1]  # a correction of order 1/c, not 0
     for previous, current in zip(changes, changes[1:]):
         assert 1.9 < previous / current < 2.3, changes
+
+
+def test_loop_velocity_converges_spectrally_in_quadrature_points():
+    """u of the elastic loop (n = 16, ε = 1e-3) against m = 16n + 1 points: 2n + 2 points
+    are off by ~1e-5, 3n + 1 by ~1e-7, the local model's 4n + 1 grid by ~1e-10."""
+    n = 16
+    x = perturbed_loop(n)
+    reference = nl.nonlocal_loop_velocity(x, 60.0, 10.0, 1e-3, quadrature_points=16 * n + 1)[1]
+    errors = [np.abs(nl.nonlocal_loop_velocity(x, 60.0, 10.0, 1e-3, quadrature_points=m)[1]
+                     - reference).max() / np.abs(reference).max()
+              for m in (2 * n + 2, 3 * n + 1, 4 * n + 1)]
+    assert errors[0] < 1e-3 and errors[2] < 1e-9
+    assert errors[1] < 1e-2 * errors[0] and errors[2] < 1e-2 * errors[1]  # geometric in m
