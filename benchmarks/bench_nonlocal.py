@@ -16,8 +16,11 @@ timed loops each (µs per call):
   right-hand side's extra cost over the local one with a dense tension solve;
 * ``iter5``: (local_rhs + geometry + 5 apply) / local_rhs, the estimate for a tension
   solved by the local solve plus corrections, five applications of K in all.
-Both are estimates from the kernels' timings, not a nonlocal right-hand side (which the
-model module will time); the target for that is 5× the local one at n = 16.
+Both are estimates from the kernels' timings;
+
+* ``nonlocal``: measured, the compiled nonlocal velocity and tension
+  (``nonlocal_maps.nonlocal_loop_velocity``: the dense least-squares tension on the local
+  model's 4n + 1 grid) over local_rhs (the target: 5× at n = 16).
 
 Run it alone with OPENBLAS_NUM_THREADS=1.
 """
@@ -44,6 +47,13 @@ def _geometry(position, tangent, singular, weight, direction, repeats):
 
 
 @numba.njit(cache=True)
+def _nonlocal(x, g0, w, c, singular, ops, ws, position, weight, direction, u, repeats):
+    for _ in range(repeats):
+        nonlocal_maps.nonlocal_loop_velocity(x, g0, w, c, singular, ops, ws, position, weight,
+                                             direction, u)
+
+
+@numba.njit(cache=True)
 def _apply(weight, direction, f, out, repeats):
     for _ in range(repeats):
         nonlocal_maps.apply_kernel(weight, direction, f, out)
@@ -59,7 +69,7 @@ def main():
     raw[1, 4], raw[1, 6] = 0.95, 0.05
     raw[2, 6] = 0.1
     print(f"{'n':>3} {'m':>4} {'local_rhs':>10} {'geometry':>9} {'apply':>8} {'dense':>6} "
-          f"{'iter5':>6}")
+          f"{'iter5':>6} {'nonlocal':>9} {'ratio':>6}")
     for n in (int(v) for v in args.orders.split(",")):
         x = nonlocal_operator.arclength_parametrised(raw, n)
         m = max(64, args.points_per_order * n)
@@ -76,8 +86,14 @@ def main():
         apply = per_call(_apply, (weight, direction, force, out), repeats)
         dense = (geometry + (2 * n + 2) * apply) / local
         iterated = (local + geometry + 5 * apply) / local
+        grid = 4 * n + 1
+        nonlocal_args = (x, 100.0, 10.0, nonlocal_operator.slenderness_constant(1e-3),
+                         nonlocal_operator.singular_weights(grid), problem.ops, problem.ws,
+                         np.empty((3, grid)), np.empty((grid, grid)), np.empty((3, grid, grid)),
+                         np.empty_like(x))
+        full = per_call(_nonlocal, nonlocal_args, repeats)
         print(f"{n:3d} {m:4d} {local:10.1f} {geometry:9.1f} {apply:8.1f} {dense:6.1f} "
-              f"{iterated:6.1f}")
+              f"{iterated:6.1f} {full:9.1f} {full / local:6.1f}")
 
 
 if __name__ == "__main__":

@@ -69,3 +69,23 @@ def test_apply_kernel_is_linear_and_sees_a_shift_along_the_grid(rng):
     out = np.empty((3, m))
     nonlocal_maps.apply_kernel(weight_moved, direction_moved, np.roll(f, -j, axis=1), out)
     assert np.abs(out - np.roll(kf, -j, axis=1)).max() < 1e-11 * np.abs(kf).max()
+
+
+@pytest.mark.parametrize("n, eps", [(12, 1e-3), (16, 1e-4)])
+def test_nonlocal_loop_velocity_matches_its_numpy_twin(n, eps):
+    """The compiled nonlocal velocity and tension on the local model's 4n + 1 grid against
+    the dense NumPy reference (nonlocal_matrix on the same grid, numpy.linalg.lstsq)."""
+    from loopsim.models import local_sbt
+
+    x = perturbed_loop(n)
+    g0, w = 60.0, 10.0
+    m = 4 * n + 1
+    ops, ws = local_sbt.make_operators(n), local_sbt.make_workspace(n)
+    u = np.empty_like(x)
+    nonlocal_maps.nonlocal_loop_velocity(
+        x, g0, w, nl.slenderness_constant(eps), nl.singular_weights(m), ops, ws,
+        np.empty((3, m)), np.empty((m, m)), np.empty((3, m, m)), u)
+    tension, reference = nl.loop_tension_and_velocity(
+        x, g0, w, nl.nonlocal_matrix(x, eps, quadrature_points=m))
+    assert np.abs(u - reference).max() < 1e-10 * np.abs(reference).max()
+    assert np.abs(ws.tension - tension).max() < 1e-10 * np.abs(tension).max()

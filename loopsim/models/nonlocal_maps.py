@@ -16,6 +16,8 @@ density on the fluid, grid values component-major (3, m)).
 import numpy as np
 
 from ..jit import kernel
+from ..linalg import least_squares_affine
+from .loop_maps import force_map, length_creation_map, shape_on_grid
 from .nonlocal_operator import LOG_4_OVER_PI
 
 
@@ -80,3 +82,60 @@ def apply_kernel(weight, direction, f, out):
         out[0, i] = acc0
         out[1, i] = acc1
         out[2, i] = acc2
+
+
+@kernel
+def nonlocal_velocity_map(c, weight, direction, ws):
+    """Map (2) of ``loop_maps`` in nonlocal hydrodynamics, for every column of ws.force
+    (M, 3, J) (``loop_maps.force_map``): ws.mobile = (1/c) [(c+1) f + (c−3) (x'·f) x' + K[f]]
+    on the grid, K from :func:`kernel_geometry`'s weight and direction on the same grid."""
+    t, f, mobile = ws.tangent, ws.force, ws.mobile
+    m, cols = f.shape[0], f.shape[2]
+    inverse_c = 1.0 / c
+    for i in range(m):
+        for col in range(cols):
+            h = t[0, i] * f[i, 0, col] + t[1, i] * f[i, 1, col] + t[2, i] * f[i, 2, col]
+            for a in range(3):
+                mobile[i, a, col] = (c + 1.0) * f[i, a, col] + (c - 3.0) * h * t[a, i]
+        for j in range(m):
+            w = weight[i, j]
+            e0 = direction[0, i, j]
+            e1 = direction[1, i, j]
+            e2 = direction[2, i, j]
+            for col in range(cols):
+                f0 = f[j, 0, col]
+                f1 = f[j, 1, col]
+                f2 = f[j, 2, col]
+                along = w * (e0 * f0 + e1 * f1 + e2 * f2)
+                mobile[i, 0, col] += w * f0 + along * e0
+                mobile[i, 1, col] += w * f1 + along * e1
+                mobile[i, 2, col] += w * f2 + along * e2
+        for col in range(cols):
+            for a in range(3):
+                mobile[i, a, col] *= inverse_c
+
+
+@kernel
+def nonlocal_loop_velocity(x, g0, w, c, singular, ops, ws, position, weight, direction, u_out):
+    """Velocity coefficients u (3, K) of the loop x (3, K) in nonlocal slender-body theory
+    (c = −2 log ε), its least-squares tension left in ws.tension: ``loop_maps``' column
+    blocks with map (2) replaced by :func:`nonlocal_velocity_map`, all on the local model's
+    M = 4n + 1 grid (``ops``, ``ws`` of ``loop_maps``; singular = the weights q of that
+    grid; position (3, M), weight (M, M) and direction (3, M, M) scratch).  The plain-NumPy
+    twin: ``nonlocal_operator.loop_tension_and_velocity`` with ``nonlocal_matrix`` on M
+    points."""
+    shape_on_grid(x, ops, ws)
+    np.dot(x, ops.S0T, position)
+    kernel_geometry(position, ws.tangent, singular, weight, direction)
+    force_map(g0, ops, ws)
+    nonlocal_velocity_map(c, weight, direction, ws)
+    length_creation_map(w, ops, ws)
+    least_squares_affine(ws.length_rate, ws.tension, ws.tau)
+    k = ops.S0.shape[1]
+    for i in range(ops.m):
+        for a in range(3):
+            acc = ws.mobile[i, a, k]
+            for j in range(k):
+                acc += ws.mobile[i, a, j] * ws.tension[j]
+            ws.velocity[a, i] = acc
+    np.dot(ws.velocity, ops.FT, u_out)
