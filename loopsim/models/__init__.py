@@ -1,16 +1,18 @@
 """Models: the equations of motion behind one interface (``models.base``).
 
 * ``local_sbt``: the sedimenting loop in local slender-body theory (the paper's model);
+* ``nonlocal_sbt``: the same loop in nonlocal slender-body theory (not yet on the
+  command line nor in the batch kernel);
 * ``riccati``: a closed-form test problem for the integrators.
 
-A new model (say, nonlocal hydrodynamics) is one module implementing the
+A new model is one module implementing the
 interface, imported here so its implementations are registered.
 """
 
 import numpy as np
 
 from ..jit import entry
-from . import local_sbt, riccati  # noqa: F401 - importing registers the implementations
+from . import local_sbt, nonlocal_sbt, riccati  # noqa: F401 - importing registers them
 from .base import (
     auxiliary, for_case, implements, jacobian, monitored_errors, rhs, steady_invariants,
 )
@@ -18,7 +20,8 @@ from .base import (
 __all__ = ["rhs", "jacobian", "monitored_errors",
            "steady_invariants",
            "auxiliary",
-           "for_case", "implements", "evaluate", "evaluate_jacobian", "local_sbt", "riccati"]
+           "for_case", "implements", "evaluate", "evaluate_jacobian", "local_sbt", "nonlocal_sbt",
+           "riccati"]
 
 
 @entry

@@ -1,0 +1,76 @@
+"""Nonlocal slender-body theory: the loop of ``local_sbt`` with the full SBT mobility,
+problem type :class:`NonlocalProblem` (docs/nonlocal.md).
+
+The same state, force, penalty and least-squares tension as the local model; the
+velocity u = (1/c)(Λ + K)[f] (c = −2 log ε, ε = a/L) on the local model's 4n + 1 grid
+(``nonlocal_maps.nonlocal_loop_velocity``), which tends to the local model as c → ∞.
+The Jacobian is by forward differences (3K right-hand sides).  Not yet in the batch
+kernel (no ``for_case``), nor on the command line: ``make_problem`` and
+``integrators.integrate`` run it.
+"""
+import collections
+
+import numpy as np
+
+from ..linalg import copy_into
+from .base import auxiliary, implements, jacobian, monitored_errors, rhs, steady_invariants
+from .loop_maps import make_operators, make_workspace
+from .loop_shape import relative_length_error, shape_invariants, spectral_tail, top_mode_share
+from .nonlocal_maps import nonlocal_loop_velocity
+from .nonlocal_operator import singular_weights, slenderness_constant
+
+#: The problem: g0, w and c = −2 log ε; the local model's operators and workspace; the
+#: nonlocal rule's weights q on the grid and its scratch (grid positions, W, e).
+NonlocalProblem = collections.namedtuple(
+    "NonlocalProblem", "g0 w c singular ops ws position weight direction")
+
+
+def make_problem(n, g0, w, eps, ops=None):
+    """Nonlocal loop problem at truncation n and slenderness ε = a/L (operators shared
+    when given)."""
+    ops = make_operators(n) if ops is None else ops
+    m = ops.m
+    return NonlocalProblem(float(g0), float(w), slenderness_constant(eps), singular_weights(m),
+                           ops, make_workspace(n), np.empty((3, m)), np.empty((m, m)),
+                           np.empty((3, m, m)))
+
+
+@implements(rhs, NonlocalProblem)
+def _nonlocal_rhs(problem, y, dydt):
+    k = y.shape[0] // 3
+    nonlocal_loop_velocity(y.reshape((3, k)), problem.g0, problem.w, problem.c,
+                           problem.singular, problem.ops, problem.ws, problem.position,
+                           problem.weight, problem.direction, dydt.reshape((3, k)))
+
+
+@implements(jacobian, NonlocalProblem)
+def _nonlocal_jacobian(problem, y, f, jac, work_y, work_f):
+    """Forward differences, column j with step sqrt(eps_mach) max(1, |y_j|); returns the
+    RHS evaluations (3K)."""
+    size = y.shape[0]
+    copy_into(work_y, y)
+    for j in range(size):
+        step = 1.4901161193847656e-08 * max(1.0, abs(y[j]))
+        work_y[j] = y[j] + step
+        rhs(problem, work_y, work_f)
+        for i in range(size):
+            jac[i, j] = (work_f[i] - f[i]) / step
+        work_y[j] = y[j]
+    return size
+
+
+@implements(monitored_errors, NonlocalProblem)
+def _nonlocal_errors(problem, y):
+    x = y.reshape((3, y.shape[0] // 3))
+    return (relative_length_error(x, problem.ops, problem.ws), spectral_tail(x),
+            top_mode_share(x))
+
+
+@implements(steady_invariants, NonlocalProblem)
+def _nonlocal_invariants(problem, y):
+    return shape_invariants(y.reshape((3, y.shape[0] // 3)))
+
+
+@implements(auxiliary, NonlocalProblem)
+def _nonlocal_multiplier(problem, out):
+    copy_into(out, problem.ws.tension)
