@@ -485,3 +485,24 @@ def test_loop_velocity_converges_spectrally_in_quadrature_points():
               for m in (2 * n + 2, 3 * n + 1, 4 * n + 1)]
     assert errors[0] < 1e-3 and errors[2] < 1e-9
     assert errors[1] < 1e-2 * errors[0] and errors[2] < 1e-2 * errors[1]  # geometric in m
+
+
+@pytest.mark.parametrize("eps", EPSILONS)
+def test_settling_angle_of_the_tilted_rigid_ring(eps):
+    """The closed form against the rigid ring's computed velocity under gravity at tilts
+    around θ*: its angle to the vertical is largest at θ* and equals φ_max there; the
+    local model's is the paper's tan⁻¹(1/(4√3)) at cos 2θ0 = 1/7."""
+    phi_max, theta_star = nl.settling_angle(eps)
+
+    def angle(theta_deg):
+        theta = np.radians(theta_deg)
+        x = inclined_circle(1, theta)
+        velocity, _ = nl.rigid_velocity(x, 2 * np.pi * np.array([0.0, 0.0, -1.0]), eps=eps)
+        return np.degrees(np.arctan2(np.hypot(velocity[0], velocity[1]), -velocity[2]))
+
+    assert abs(angle(theta_star) - phi_max) < 1e-9
+    assert angle(theta_star - 2.0) < phi_max and angle(theta_star + 2.0) < phi_max
+    local_phi, local_theta = nl.settling_angle()
+    assert abs(local_phi - np.degrees(np.arctan(1 / (4 * np.sqrt(3))))) < 1e-12
+    assert abs(np.cos(2 * np.radians(local_theta)) - 1 / 7) < 1e-12
+    assert phi_max < local_phi  # nonlocal hydrodynamics settles the ring less steeply

@@ -453,6 +453,25 @@ def johnson_wu_ring(eps):
     return broadside, edgewise
 
 
+def settling_angle(eps=None):
+    """(φ_max, θ*) in degrees: the largest angle between the rigid ring's velocity and
+    gravity over its tilts, and the tilt θ* (axis from the vertical) reaching it.  With the
+    ring's mobilities M_b (broadside) and M_e (edgewise), r = M_e / M_b,
+
+        tan φ = (r − 1) sin θ cos θ / (cos² θ + r sin² θ),  largest at tan θ* = 1/√r:
+        tan φ_max = (r − 1) / (2√r);
+
+    ``eps`` None: the local model (M_b = 1, M_e = 4/3: φ_max = tan⁻¹(1/(4√3)) = 8.2132°,
+    the paper's §4), else Johnson & Wu's mobilities (:func:`johnson_wu_ring`)."""
+    if eps is None:
+        ratio = 4.0 / 3.0
+    else:
+        broadside, edgewise = johnson_wu_ring(eps)
+        ratio = edgewise / broadside
+    phi = math.atan((ratio - 1.0) / (2.0 * math.sqrt(ratio)))
+    return math.degrees(phi), math.degrees(math.atan(1.0 / math.sqrt(ratio)))
+
+
 # ---- shapes ---------------------------------------------------------------------------------
 
 def arclength_parametrised(x, n, points=None):
