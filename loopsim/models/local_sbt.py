@@ -50,21 +50,25 @@ def _loop_jacobian(problem, y, f, jac, work_y, work_f):
     return 1  # one velocity evaluation inside
 
 
+# The monitors and the multiplier read only the shape and the fields ops and ws: every
+# model of this loop (``nonlocal_sbt`` too) registers these same implementations.
 @implements(monitored_errors, LoopProblem)
-def _loop_errors(problem, y):
+def loop_errors(problem, y):
+    """(relative length error, spectral tail, top-mode share) of the loop y."""
     x = y.reshape((3, y.shape[0] // 3))
     return (relative_length_error(x, problem.ops, problem.ws), spectral_tail(x),
             top_mode_share(x))
 
 
 @implements(steady_invariants, LoopProblem)
-def _loop_invariants(problem, y):
-    k = y.shape[0] // 3
-    return shape_invariants(y.reshape((3, k)))
+def loop_invariants(problem, y):
+    """The shape invariants of the loop y (``loop_shape.shape_invariants``)."""
+    return shape_invariants(y.reshape((3, y.shape[0] // 3)))
 
 
 @implements(auxiliary, LoopProblem)
-def _loop_multiplier(problem, out):
+def loop_multiplier(problem, out):
+    """The tension multiplier of the last right-hand side (problem.ws.tension)."""
     copy_into(out, problem.ws.tension)
 
 

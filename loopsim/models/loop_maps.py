@@ -271,6 +271,14 @@ def loop_velocity_blocks(x, g0, w, ops, ws, u_out):
     The least-squares solve destroys ws.length_rate; the residual is not kept.
     """
     compose_maps(x, g0, w, ops, ws)
+    velocity_from_blocks(ops, ws, u_out)
+
+
+@kernel
+def velocity_from_blocks(ops, ws, u_out):
+    """From the column blocks (ws.length_rate: T -> ε; ws.mobile: T -> u on the grid): the
+    least-squares tension T into ws.tension (ws.length_rate destroyed) and the velocity
+    coefficients u = F (Σ_j mobile_j T_j + mobile_K) into u_out (3, K)."""
     least_squares_affine(ws.length_rate, ws.tension, ws.tau)
     k = ops.S0.shape[1]
     for i in range(ops.m):

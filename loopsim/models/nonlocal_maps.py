@@ -16,8 +16,7 @@ density on the fluid, grid values component-major (3, m)).
 import numpy as np
 
 from ..jit import kernel
-from ..linalg import least_squares_affine
-from .loop_maps import force_map, length_creation_map, shape_on_grid
+from .loop_maps import force_map, length_creation_map, shape_on_grid, velocity_from_blocks
 from .nonlocal_operator import LOG_4_OVER_PI
 
 
@@ -130,12 +129,4 @@ def nonlocal_loop_velocity(x, g0, w, c, singular, ops, ws, position, weight, dir
     force_map(g0, ops, ws)
     nonlocal_velocity_map(c, weight, direction, ws)
     length_creation_map(w, ops, ws)
-    least_squares_affine(ws.length_rate, ws.tension, ws.tau)
-    k = ops.S0.shape[1]
-    for i in range(ops.m):
-        for a in range(3):
-            acc = ws.mobile[i, a, k]
-            for j in range(k):
-                acc += ws.mobile[i, a, j] * ws.tension[j]
-            ws.velocity[a, i] = acc
-    np.dot(ws.velocity, ops.FT, u_out)
+    velocity_from_blocks(ops, ws, u_out)

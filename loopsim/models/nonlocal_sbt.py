@@ -13,9 +13,9 @@ import collections
 import numpy as np
 
 from ..linalg import copy_into
+from . import local_sbt
 from .base import auxiliary, implements, jacobian, monitored_errors, rhs, steady_invariants
 from .loop_maps import make_operators, make_workspace
-from .loop_shape import relative_length_error, shape_invariants, spectral_tail, top_mode_share
 from .nonlocal_maps import nonlocal_loop_velocity
 from .nonlocal_operator import singular_weights, slenderness_constant
 
@@ -59,18 +59,7 @@ def _nonlocal_jacobian(problem, y, f, jac, work_y, work_f):
     return size
 
 
-@implements(monitored_errors, NonlocalProblem)
-def _nonlocal_errors(problem, y):
-    x = y.reshape((3, y.shape[0] // 3))
-    return (relative_length_error(x, problem.ops, problem.ws), spectral_tail(x),
-            top_mode_share(x))
-
-
-@implements(steady_invariants, NonlocalProblem)
-def _nonlocal_invariants(problem, y):
-    return shape_invariants(y.reshape((3, y.shape[0] // 3)))
-
-
-@implements(auxiliary, NonlocalProblem)
-def _nonlocal_multiplier(problem, out):
-    copy_into(out, problem.ws.tension)
+for _generic, _implementation in ((monitored_errors, local_sbt.loop_errors),
+                                   (steady_invariants, local_sbt.loop_invariants),
+                                   (auxiliary, local_sbt.loop_multiplier)):
+    implements(_generic, NonlocalProblem)(_implementation)  # the local model's: same fields
