@@ -23,6 +23,8 @@ from .nonlocal_operator import singular_weights, slenderness_constant
 #: nonlocal rule's weights q on the grid and its scratch (grid positions, W, e).
 NonlocalProblem = collections.namedtuple(
     "NonlocalProblem", "g0 w c singular ops ws position weight direction")
+#: Relative step of the forward-difference Jacobian: sqrt of the machine epsilon.
+DIFFERENCE_STEP = float(np.sqrt(np.finfo(float).eps))
 
 
 def make_problem(n, g0, w, eps, ops=None):
@@ -45,12 +47,12 @@ def _nonlocal_rhs(problem, y, dydt):
 
 @implements(jacobian, NonlocalProblem)
 def _nonlocal_jacobian(problem, y, f, jac, work_y, work_f):
-    """Forward differences, column j with step sqrt(eps_mach) max(1, |y_j|); returns the
+    """Forward differences, column j with step DIFFERENCE_STEP max(1, |y_j|); returns the
     RHS evaluations (3K)."""
     size = y.shape[0]
     copy_into(work_y, y)
     for j in range(size):
-        step = 1.4901161193847656e-08 * max(1.0, abs(y[j]))
+        step = DIFFERENCE_STEP * max(1.0, abs(y[j]))
         work_y[j] = y[j] + step
         rhs(problem, work_y, work_f)
         for i in range(size):
