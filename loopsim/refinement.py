@@ -60,8 +60,10 @@ def level_options(options, tail_tol, top):
     return options._replace(resolution_tol=np.inf if top else float(tail_tol))
 
 
-def integrate_case(method, g0, w, x0, t0, t_end, t_eval, options, ladder, tail_tol):
-    """One case up the ladder (from x0 (3, 2 ladder[0] + 1) at t0), each order from t0.
+def integrate_case(method, g0, w, x0, t0, t_end, t_eval, options, ladder, tail_tol,
+                   model=models.LOCAL):
+    """One case of ``model`` (``models.Model``) up the ladder (from x0 (3, 2 ladder[0] + 1)
+    at t0), each order from t0.
 
     Returns (status, t_final, x_final, n_used, counts, worst, x_out): counts as
     ``integrators.integrate``, summed over the levels (the work of every level);
@@ -78,7 +80,7 @@ def integrate_case(method, g0, w, x0, t0, t_end, t_eval, options, ladder, tail_t
         y0 = spectral.resize(x0, n).ravel()
         with one_blas_thread():  # output only at t0 and t_end: the driver without output
             status, t, y, level_counts, worst = integrators.integrate(
-                method, models.local_sbt.make_problem(n, g0, w), y0, t0, t_end,
+                method, models.make_problem(model, n, g0, w), y0, t0, t_end,
                 None if ends_only else t_eval,
                 level_options(options, tail_tol, level == len(ladder) - 1),
                 None if ends_only else rows)
@@ -92,10 +94,13 @@ def integrate_case(method, g0, w, x0, t0, t_end, t_eval, options, ladder, tail_t
     return int(status), float(t), y.reshape(3, -1), n, counts, worst[:2].copy(), x_out
 
 
-def integrate_cases(method, parameters, x0, t_end, options, ladder, tail_tol, cost=None):
-    """Many cases up the ladder, each level in the parallel batch kernel, each order from t0.
+def integrate_cases(method, parameters, x0, t_end, options, ladder, tail_tol, cost=None,
+                    model=models.LOCAL):
+    """Many cases of ``model`` up the ladder, each level in the parallel batch kernel, each
+    order from t0.
 
-    x0 (B, 3, 2 ladder[0] + 1); parameters (B, 2) = (g0, w).  Returns (x_final,
+    x0 (B, 3, 2 ladder[0] + 1); parameters (B, P) each case's
+    ``models.case_parameters``.  Returns (x_final,
     n_used, t_final, status, counts, worst): x_final a list of B arrays (3, 2 n_used
     + 1); counts summed over the levels; the others those of each case's last level.
     """
@@ -116,7 +121,7 @@ def integrate_cases(method, parameters, x0, t_end, options, ladder, tail_tol, co
             break
         with one_blas_thread():  # the cases run in parallel already
             y_final, t_final, level_status, level_counts, level_worst = batch.integrate_cases(
-                method, models.local_sbt.make_operators(n), parameters[active],
+                method, models.case_constants(model, n), parameters[active],
                 np.array([spectral.resize(x0[b], n).ravel() for b in active]), t_end[active],
                 level_options(options, tail_tol, level == len(ladder) - 1),
                 cost=cost[active])

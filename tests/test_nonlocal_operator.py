@@ -23,6 +23,7 @@ from scipy import integrate
 
 import naive
 from loopsim import spectral
+from loopsim.models import nonlocal_circle as closed
 from loopsim.models import nonlocal_operator as nl
 from loopsim.shapes import inclined_circle
 
@@ -114,7 +115,7 @@ def test_singular_weights_integrate_trigonometric_polynomials_exactly(m):
     q = nl.singular_weights(m)
     s = spectral.grid(m)
     k = np.arange(1, m // 2 + 1)  # degrees < m/2, and the Nyquist cos(mσ/2) for even m
-    h = nl.odd_harmonic_digamma(k)
+    h = closed.odd_harmonic_digamma(k)
     assert np.allclose(nl.odd_harmonic(k), h, rtol=0, atol=1e-13)
     assert abs(q.sum()) < 1e-12
     for kk, hk in zip(k, h):
@@ -165,7 +166,7 @@ def kernel_integral_on_circle(k, component):
 
 @pytest.mark.parametrize("k", range(7))
 def test_circle_closed_forms_match_quadrature_of_the_kernel(k):
-    c = nl.circle_K_mode_matrix(k)
+    c = closed.circle_K_mode_matrix(k)
     assert np.allclose(c, c.conj().T, atol=1e-15)  # K is symmetric
     for component in range(3):
         assert np.allclose(kernel_integral_on_circle(k, component), c[:, component],
@@ -188,7 +189,7 @@ def test_operator_on_circle_modes_matches_closed_forms(k, rng):
     moved = rotation @ circle()
     moved[:, 0] += rng.standard_normal(3)
     eps = 1e-3
-    kmat, umat = nl.circle_K_mode_matrix(k), nl.circle_velocity_mode_matrix(k, eps)
+    kmat, umat = closed.circle_K_mode_matrix(k), closed.circle_velocity_mode_matrix(k, eps)
     for alpha in (1.0, -1j):  # cos ks, sin ks
         for component, vec in enumerate(frame(s)):
             f = np.real(alpha * np.exp(1j * k * s)) * vec
@@ -215,9 +216,20 @@ def test_high_modes_lose_positivity_where_the_closed_form_says():
                 for row, w in enumerate((t, n)):  # the e^{iks} amplitude of u·w
                     amp = 2.0 * np.mean(np.sum(u * w, axis=0) * np.exp(-1j * k * s))
                     block[row, column] += amp / 2.0 if alpha == 1.0 else 1j * amp / 2.0
-        exact = nl.circle_velocity_mode_matrix(k, eps)[:2, :2]
+        exact = closed.circle_velocity_mode_matrix(k, eps)[:2, :2]
         assert np.allclose(block, exact, atol=1e-12)
         assert (np.linalg.eigvalsh(exact).min() > 0) == positive
+
+
+
+@pytest.mark.parametrize("eps", [1e-1, 3e-2, 1e-2, 1e-3])
+def test_first_nonpositive_mode_is_the_first_of_a_linear_scan(eps):
+    """The bisection's answer equals a scan k = 1, 2, ... of the closed-form spectrum."""
+    k = 1
+    while np.linalg.eigvalsh(closed.circle_velocity_mode_matrix(k, eps)).min() > 0:
+        k += 1
+    assert closed.first_nonpositive_mode(eps) == k
+    assert k == {1e-1: 1, 3e-2: 4, 1e-2: 11, 1e-3: 109}[eps]  # docs/nonlocal.md's table
 
 
 # ---- matrix, shift, local limit --------------------------------------------------------------
@@ -293,14 +305,14 @@ def test_johnson_wu_in_loopsim_units():
         c = nl.slenderness_constant(eps)
         # density g = F/(2πR), loopsim velocity = 8πμ U / (c g)
         expected = [8 * np.pi * mu * 2 * np.pi * big_r / (c * d) for d in (drag_broad, drag_edge)]
-        assert np.allclose(nl.johnson_wu_ring(eps), expected, rtol=1e-14)
+        assert np.allclose(closed.johnson_wu_ring(eps), expected, rtol=1e-14)
 
 
 @pytest.mark.parametrize("eps", EPSILONS)
 def test_ring_broadside_uniform_force_translates_it_as_johnson_wu(eps, rng):
     """A uniform force along the axis gives a uniform velocity (no rigidity needed), for
     the ring tilted any way and parametrised from any point."""
-    broadside, _ = nl.johnson_wu_ring(eps)
+    broadside, _ = closed.johnson_wu_ring(eps)
     for _ in range(3):
         rotation = random_rotation(rng)
         x = shifted(rotation @ circle(), rng.uniform(0, 2 * np.pi))
@@ -313,7 +325,7 @@ def test_ring_broadside_uniform_force_translates_it_as_johnson_wu(eps, rng):
 def test_rigid_ring_translates_without_rotating_as_johnson_wu(eps, rng):
     """Uniform force density g on the rigid ring, any tilt and any direction of g:
     Ω = 0 and U = M_b (g·b) b + M_e (g - (g·b) b) with Johnson & Wu's mobilities."""
-    broadside, edgewise = nl.johnson_wu_ring(eps)
+    broadside, edgewise = closed.johnson_wu_ring(eps)
     for trial in range(4):
         rotation = np.eye(3) if trial == 0 else random_rotation(rng)
         x = shifted(rotation @ circle(), rng.uniform(0, 2 * np.pi))
@@ -360,11 +372,11 @@ def test_local_rigid_circle_is_the_papers_u0_and_nonlocal_corrects_it_by_one_ove
     gravity = np.array([0.0, 0.0, -g0])
     along = (gravity @ normal) * normal
     for eps in EPSILONS:
-        broadside, edgewise = nl.johnson_wu_ring(eps)
+        broadside, edgewise = closed.johnson_wu_ring(eps)
         velocity, _ = nl.rigid_velocity(x, 2 * np.pi * gravity, eps=eps)
         assert np.abs(velocity - (broadside * along + edgewise * (gravity - along))).max() < 1e-12
     c = nl.slenderness_constant(1e-12)
-    broadside, edgewise = nl.johnson_wu_ring(1e-12)
+    broadside, edgewise = closed.johnson_wu_ring(1e-12)
     assert c * (broadside - 1.0) == pytest.approx(1.0 + 2.0 * nl.LOG_4_OVER_PI, rel=1e-12)
     assert c * (edgewise - 4.0 / 3.0) == pytest.approx(
         8.0 / 3.0 * (nl.LOG_4_OVER_PI + 1.0 / 3.0), rel=0.02)  # the next term is O(1/c)
@@ -450,7 +462,7 @@ def test_horizontal_ring_sediments_as_johnson_wu_broadside(eps):
     g0 = 3.0
     x = circle(4)
     tension, u = nl.nonlocal_loop_velocity(x, g0, 10.0, eps, quadrature_points=64)
-    broadside, _ = nl.johnson_wu_ring(eps)
+    broadside, _ = closed.johnson_wu_ring(eps)
     expected = np.zeros_like(u)
     expected[2, 0] = -g0 * broadside
     assert np.abs(u - expected).max() < 1e-11
@@ -492,7 +504,7 @@ def test_settling_angle_of_the_tilted_rigid_ring(eps):
     """The closed form against the rigid ring's computed velocity under gravity at tilts
     around θ*: its angle to the vertical is largest at θ* and equals φ_max there; the
     local model's is the paper's tan⁻¹(1/(4√3)) at cos 2θ0 = 1/7."""
-    phi_max, theta_star = nl.settling_angle(eps)
+    phi_max, theta_star = closed.settling_angle(eps)
 
     def angle(theta_deg):
         theta = np.radians(theta_deg)
@@ -502,7 +514,7 @@ def test_settling_angle_of_the_tilted_rigid_ring(eps):
 
     assert abs(angle(theta_star) - phi_max) < 1e-9
     assert angle(theta_star - 2.0) < phi_max and angle(theta_star + 2.0) < phi_max
-    local_phi, local_theta = nl.settling_angle()
+    local_phi, local_theta = closed.settling_angle()
     assert abs(local_phi - np.degrees(np.arctan(1 / (4 * np.sqrt(3))))) < 1e-12
     assert abs(np.cos(2 * np.radians(local_theta)) - 1 / 7) < 1e-12
     assert phi_max < local_phi  # nonlocal hydrodynamics settles the ring less steeply

@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from loopsim import integrators, shapes
+from loopsim.models import nonlocal_circle as closed
 from loopsim.models import nonlocal_operator as nl
 from loopsim.models import nonlocal_sbt
 
@@ -27,7 +28,7 @@ def test_horizontal_ring_sediments_at_johnson_wu_broadside_speed(eps):
     x0[1, n + 1] = 1.0
     x, _ = run(integrators.RKF45, nonlocal_sbt.make_problem(n, g0, 10.0, eps), x0, t_end)
     expected = x0.copy()
-    expected[2, 0] = -g0 * nl.johnson_wu_ring(eps)[0] * t_end
+    expected[2, 0] = -g0 * closed.johnson_wu_ring(eps)[0] * t_end
     assert np.abs(x - expected).max() < 1e-9
 
 

@@ -4,9 +4,9 @@ problem type :class:`NonlocalProblem` (docs/nonlocal.md).
 The same state, force, penalty and least-squares tension as the local model; the
 velocity u = (1/c)(Λ + K)[f] (c = −2 log ε, ε = a/L) on the local model's 4n + 1 grid
 (``nonlocal_maps.nonlocal_loop_velocity``), which tends to the local model as c → ∞.
-The Jacobian is by forward differences (3K right-hand sides).  Not yet in the batch
-kernel (no ``for_case``), nor on the command line: ``make_problem`` and
-``integrators.integrate`` run it.
+The Jacobian is by forward differences (3K right-hand sides).  Chosen with
+``model="nonlocal"`` and ``slenderness=ε`` (``models.Model``) in ``simulate``, sweeps and
+the command line.
 """
 import collections
 
@@ -14,15 +14,24 @@ import numpy as np
 
 from ..linalg import copy_into
 from . import local_sbt
-from .base import auxiliary, implements, jacobian, monitored_errors, rhs, steady_invariants
-from .loop_maps import make_operators, make_workspace
+from .base import (
+    auxiliary, for_case, implements, jacobian, monitored_errors, rhs, steady_invariants,
+)
+from .loop_maps import LoopOperators, make_operators, make_workspace
 from .nonlocal_maps import nonlocal_loop_velocity
-from .nonlocal_operator import singular_weights, slenderness_constant
+from .nonlocal_operator import singular_weights, slenderness_constant  # noqa: F401 - re-exported
 
 #: The problem: g0, w and c = −2 log ε; the local model's operators and workspace; the
 #: nonlocal rule's weights q on the grid and its scratch (grid positions, W, e).
 NonlocalProblem = collections.namedtuple(
     "NonlocalProblem", "g0 w c singular ops ws position weight direction")
+#: Order of the per-case parameters passed to ``for_case``: c = −2 log ε, not ε.
+PARAMETERS = ("g0", "w", "c")
+#: What the cases of one truncation share: the local operators' fields, then the nonlocal
+#: rule's weights (flat: Numba's parallel kernels take no nested tuples).
+NonlocalConstants = collections.namedtuple(
+    "NonlocalConstants", LoopOperators._fields + ("singular",))
+_OPERATOR_FIELDS = len(LoopOperators._fields)
 #: Relative step of the forward-difference Jacobian: sqrt of the machine epsilon.
 DIFFERENCE_STEP = float(np.sqrt(np.finfo(float).eps))
 
@@ -34,6 +43,26 @@ def make_problem(n, g0, w, eps, ops=None):
     m = ops.m
     return NonlocalProblem(float(g0), float(w), slenderness_constant(eps), singular_weights(m),
                            ops, make_workspace(n), np.empty((3, m)), np.empty((m, m)),
+                           np.empty((3, m, m)))
+
+
+def constants(problem):
+    """What every case of one truncation shares: the operators and the singular weights."""
+    return NonlocalConstants(*problem.ops, problem.singular)
+
+
+def shared_constants(n):
+    """:func:`constants` of truncation n."""
+    ops = make_operators(n)
+    return NonlocalConstants(*ops, singular_weights(ops.m))
+
+
+@implements(for_case, NonlocalConstants)
+def _nonlocal_for_case(constants, parameters):
+    ops = LoopOperators(*constants[:_OPERATOR_FIELDS])
+    m = ops.m
+    return NonlocalProblem(parameters[0], parameters[1], parameters[2], constants.singular,
+                           ops, make_workspace(ops.n), np.empty((3, m)), np.empty((m, m)),
                            np.empty((3, m, m)))
 
 
