@@ -171,10 +171,18 @@ class SimulationResult:
             **self.determinacy)
 
 
+def ladder_top(model, n_max):
+    """The top of a ``model``'s ``n="auto"`` ladder: n_max, or the model's highest order
+    (``models.highest_order``) when that is lower."""
+    top = models.highest_order(model)
+    return n_max if top is None else min(n_max, top)
+
+
 def terminal_summary(inputs, x, u, multiplier, **run_stats):
     """Summary fields of a final shape x with velocity u and multiplier T.
 
-    ``inputs``: g0, theta0_deg, n, t_end, rtol, atol, w, perturbation, seed;
+    ``inputs``: g0, theta0_deg, n, t_end, rtol, atol, w, perturbation, seed, model,
+    slenderness;
     ``run_stats``: the ``io.RUN_FIELDS`` and ``io.OUTCOME_FIELDS``.
     """
     values = dict(inputs, **run_stats)
@@ -184,24 +192,27 @@ def terminal_summary(inputs, x, u, multiplier, **run_stats):
 
 
 def twin_end_state(method, g0, w, x0, t0, t_end, options, ladder, tail_tol, theta0_deg,
-                   thresholds=outcomes.Thresholds()):
+                   thresholds=outcomes.Thresholds(), model=models.LOCAL):
     """The end state of a run's twin (``outcomes``): the same start and method, every
     tolerance ``outcomes.TWIN_FACTOR`` times stricter.  Returns
     {regime, theta_final_deg, aspect_ratio, nfev, n_used}."""
     rtol, atol, tail_tol = outcomes.twin_tolerances(options.rtol, options.atol, tail_tol)
     status, _, x, n_used, counts, _, _ = refinement.integrate_case(
         method, g0, w, x0, t0, t_end, np.empty(0), options._replace(rtol=rtol, atol=atol),
-        ladder, tail_tol)
+        ladder, tail_tol, model)
     end = outcomes.end_state(theta0_deg, diagnostics.aspect_ratio(x0), x,
                              status in integrators.SUCCESS, thresholds)
     return dict(end, nfev=int(counts[2]), n_used=int(n_used))
 
 
-def evaluate_maps(x, g0, w=DEFAULT_W):
-    """Velocity coefficients u (3, 2n+1) and multiplier T (2n+1) of shape x."""
+def evaluate_maps(x, g0, w=DEFAULT_W, *, model="local", slenderness=None):
+    """Velocity coefficients u (3, 2n+1) and multiplier T (2n+1) of shape x under ``model``
+    (``simulate``'s ``model`` and ``slenderness``)."""
     x = np.ascontiguousarray(x, dtype=float)
     n = shapes.check_coefficients(x, "x")
-    return velocity_and_multiplier(models.local_sbt.make_problem(n, g0, w), x)
+    model = models.choose(model, slenderness)
+    return velocity_and_multiplier(models.make_problem(model, models.check_order(model, n), g0, w),
+                                   x)
 
 
 def velocity_and_multiplier(problem, x):
@@ -220,7 +231,7 @@ def simulate(
     max_steps=DEFAULT_MAX_STEPS, length_tol=DEFAULT_LENGTH_TOL, first_step=None,
     max_step=math.inf, min_step=0.0, steady_tol=None, steady_interval=DEFAULT_STEADY_INTERVAL,
     initial=None, initial_case_id=None, n_max=DEFAULT_N_MAX, tail_tol=DEFAULT_TAIL_TOL,
-    n_start=None, twin=True,
+    n_start=None, twin=True, model="local", slenderness=None,
 ):
     """Simulate a loop released as a perturbed circle tilted by ``theta0_deg``.
 
@@ -234,12 +245,16 @@ def simulate(
     over stiffness, ``w`` the length-penalty rate, ``perturbation`` the RMS
     size of the seeded initial perturbation (``shapes.circle``; default 1e-3,
     n = 6).  ``n="auto"`` starts at ``n_start`` (default 6, or a given shape's
-    order) and raises n up to ``n_max`` whenever the spectral tail passes ``tail_tol``
-    (``loopsim.refinement``).  ``method="auto"`` picks the integrator for the case
+    order) and raises n up to ``n_max`` whenever the spectral tail
+    passes ``tail_tol`` (``loopsim.refinement``).  ``method="auto"`` picks the integrator for the case
     (``refinement.auto_method``).  ``twin`` (default on) also runs the stricter twin
     that says whether the outcome is determined (``loopsim.outcomes``; about doubles
     the cost); ``result.warnings()`` lists what a user should know (also issued as
-    Python warnings).
+    Python warnings).  ``model`` "local" (the paper's local slender-body theory, the
+    default) or "nonlocal" (full slender-body theory, docs/nonlocal.md) with
+    ``slenderness`` ε = a/L (filament radius over loop length); the nonlocal model's n must stay
+    below the first mode its operator is not positive at (``models.highest_order``; with
+    ``n="auto"`` the ladder stops there, whatever ``n_max``).
 
     ``initial`` starts from a given shape instead of the tilted circle:
     coefficients (3, 2m+1) or a path (point file or results, with
@@ -249,6 +264,7 @@ def simulate(
     Never raises for a failed integration: see ``result.success``.
     """
     g0 = validation.check_real("g0", g0, low=0.0)
+    model = models.choose(model, slenderness)
     refine = isinstance(n, str)
     method = validation.check_choice(
         "method", ("auto" if refine else "rkf45") if method is None else method,
@@ -266,7 +282,8 @@ def simulate(
         n = validation.check_order("n_start" if refine else "n", n)
     x0, theta0_deg, n, perturbation, initial_info = shapes.start_shape(
         theta0_deg, n, perturbation, seed, initial, initial_case_id)
-    ladder = refinement.orders(n, max(n, n_max)) if refine else (n,)
+    models.check_order(model, n, "n_start" if refine else "n")
+    ladder = refinement.orders(n, max(n, ladder_top(model, n_max))) if refine else (n,)
     if method == "auto":
         method = refinement.auto_method(stability_parameter(g0, theta0_deg), n, refine)
     method_object = integrators.METHODS[method]
@@ -294,18 +311,19 @@ def simulate(
         raise ValueError("t_eval must be finite, strictly increasing and within t_span")
 
     inputs = dict(g0=g0, theta0_deg=theta0_deg, n=n, t_end=t_end, rtol=rtol, atol=atol,
-                  w=w, perturbation=perturbation, seed=int(seed))
+                  w=w, perturbation=perturbation, seed=int(seed), model=model.name,
+                  slenderness=model.slenderness)
     options = integrators.step_options(
         rtol, atol, first_step, min_step, max_step, max_steps, length_tol,
         steady_interval if steady_tol is not None else 0.0, steady_tol or 0.0)
     compiled = _jitcache.compile_seconds()
     start = time.perf_counter()
     status, t_final, x_final, n_used, counts, worst, x_out = refinement.integrate_case(
-        method_object, g0, w, x0, t0, t_end, t_eval, options, ladder, tail_tol)
+        method_object, g0, w, x0, t0, t_end, t_eval, options, ladder, tail_tol, model)
     twin_state = None
     if twin and status in integrators.SUCCESS:
         twin_state = twin_end_state(method_object, g0, w, x0, t0, t_end, options, ladder,
-                                    tail_tol, theta0_deg)
+                                    tail_tol, theta0_deg, model=model)
     elif twin:  # a failed run has no outcome to check: no twin is run, and it is not determined
         twin_state = dict(regime="failed", theta_final_deg=math.nan, aspect_ratio=math.nan,
                           nfev=0, n_used=int(n_used))
@@ -314,7 +332,7 @@ def simulate(
     if twin_state is not None:  # the twin's time is not the run's: split by RHS evaluations
         wall *= float(counts[2]) / (counts[2] + twin_state["nfev"])
 
-    problem = models.local_sbt.make_problem(n_used, g0, w)
+    problem = models.make_problem(model, n_used, g0, w)
     reached = t_eval <= t_final
     x = x_out[reached]
     u = np.empty_like(x)

@@ -32,6 +32,10 @@ RESULT_COLUMNS = {
     "w": ("1/t_u", "length-penalty rate of the inextensibility constraint"),
     "perturbation": (LENGTH, "RMS size of the seeded initial perturbation"),
     "seed": (COUNT, "seed of the initial perturbation"),
+    "model": (TEXT, "the hydrodynamic model: local (the paper's local slender-body theory) "
+                    "or nonlocal (full slender-body theory, docs/nonlocal.md)"),
+    "slenderness": (ONE, "filament radius over loop length, a/L, of the nonlocal model "
+                         "(null for the local one)"),
     "method": (TEXT, "the integrator that ran the case: rkf45 or radau5 (--method auto "
                      "chooses per case)"),
     "n_used": (COUNT, "the truncation order the case ended at (with --n auto: the order "

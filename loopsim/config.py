@@ -86,6 +86,14 @@ DEFORMATION_FLOOR = 1e-3
 #: climb, the default top order, and the spectral-tail tolerance that sends a case up.
 AUTO_ORDERS = (6, 8, 12, 16, 20, 24, 32, 40, 48, 64)
 DEFAULT_N_MAX = 32
+#: The loop's models (``--model``, ``simulate(model=)``; ``loopsim.models``): the paper's
+#: local slender-body theory (the default) and nonlocal slender-body theory, which needs
+#: the slenderness ε = a/L (``--slenderness``) and a truncation below the first mode its
+#: operator is not positive at (``models.nonlocal_circle.first_nonpositive_mode``).
+MODEL_CHOICES = ("local", "nonlocal")
+#: Largest slenderness a/L the nonlocal model accepts: at 0.1 the operator is not positive
+#: from mode 1 on (docs/nonlocal.md, "High modes"); slender-body theory needs ε ≪ 1.
+MAX_SLENDERNESS = 0.05
 DEFAULT_TAIL_TOL = RESOLVED_TAIL
 #: ``--seeds auto``'s targets, by option name (``--p-halfwidth``, ``sweep(p_halfwidth=)``):
 #: (``seeding.SeedTargets`` field, default).  The defaults are defended in

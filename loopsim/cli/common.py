@@ -7,7 +7,7 @@ import sys
 
 from ..config import (
     DEFAULT_ATOL, DEFAULT_N, DEFAULT_N_MAX, DEFAULT_PERTURBATION, DEFAULT_RTOL, DEFAULT_T_END,
-    DEFAULT_TAIL_TOL, DEFAULT_W,
+    DEFAULT_TAIL_TOL, DEFAULT_W, MAX_SLENDERNESS, MODEL_CHOICES,
 )
 
 
@@ -49,8 +49,21 @@ def real(text):
     return value
 
 
+def add_model_options(parser):
+    """--model and --slenderness: the hydrodynamics of the loop."""
+    parser.add_argument("--model", default="local", choices=MODEL_CHOICES,
+                        help="hydrodynamics: local (the paper's local slender-body theory) or "
+                        "nonlocal (full slender-body theory, needs --slenderness; "
+                        "docs/nonlocal.md)")
+    parser.add_argument("--slenderness", type=real, default=None, metavar="EPS",
+                        help="with --model nonlocal: filament radius over loop length, a/L, "
+                        f"in (0, {MAX_SLENDERNESS:g}]; n must stay below the mode where "
+                        "slender-body theory fails (n <= 10 at 1e-2, <= 108 at 1e-3)")
+
+
 def add_integration_options(parser):
     """Options shared by every command that integrates loops."""
+    add_model_options(parser)
     parser.add_argument("--t-end", type=real, default=DEFAULT_T_END, help="final time")
     parser.add_argument("--rtol", type=real, default=DEFAULT_RTOL, help="relative tolerance")
     parser.add_argument("--atol", type=real, default=DEFAULT_ATOL, help="absolute tolerance")

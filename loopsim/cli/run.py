@@ -130,7 +130,8 @@ def _run(args):
         api.simulate, g0, args.theta0, n=args.n, t_span=(0.0, args.t_end),
         snapshots=args.snapshots, rtol=args.rtol, atol=args.atol, w=args.w,
         perturbation=args.perturbation, seed=args.seed, method=args.method, initial=start,
-        n_max=args.n_max, tail_tol=args.tail_tol, twin=not args.no_twin)
+        n_max=args.n_max, tail_tol=args.tail_tol, twin=not args.no_twin, model=args.model,
+        slenderness=args.slenderness)
     for warning in [] if info is None else info["warnings"]:  # the input's, before the run's
         print(f"loopsim: warning: {warning}", file=sys.stderr)
     stop = sweeps.stop_event()

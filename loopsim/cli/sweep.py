@@ -135,7 +135,8 @@ def _sweep_config(args, sweeps):
     return sweeps.SweepConfig(cases=cases, t_end=args.t_end, rtol=args.rtol, atol=args.atol,
                               w=args.w, method=args.method or (
                                   "auto" if args.n == "auto" else "rkf45"),
-                              twin=not args.no_twin,
+                              twin=not args.no_twin, model=args.model,
+                              slenderness=args.slenderness,
                               chunk_size=(args.chunk_size if args.chunk_size is not None
                                           else DEFAULT_AUTO_CHUNK_SIZE if args.n == "auto"
                                           else DEFAULT_CHUNK_SIZE),

@@ -197,9 +197,19 @@ def requires_hash(stored):
     return bool(stored) and stored.get("checksums") == CONTENT_KEY
 
 
+#: Columns added since result files were first written, with the value their rows had
+#: before (a file written earlier holds local-model rows without these columns).
+ADDED_COLUMNS = {"model": "local", "slenderness": None}
+
+
 def result_table(table):
-    """A verified result file's table in RESULT_SCHEMA (metadata dropped)."""
+    """A verified result file's table in RESULT_SCHEMA (metadata dropped; columns added
+    since the file was written filled in from ``ADDED_COLUMNS``)."""
     table = table.replace_schema_metadata(None)
+    for name, value in ADDED_COLUMNS.items():
+        if name not in table.schema.names:
+            kind = RESULT_SCHEMA.field(name).type
+            table = table.append_column(name, pa.array([value] * table.num_rows, kind))
     if not table.schema.equals(RESULT_SCHEMA):
         table = table.select(RESULT_SCHEMA.names).cast(RESULT_SCHEMA)
     return table

@@ -23,7 +23,7 @@ COEFFICIENT_LAYOUT = (
 
 #: Summary fields, in order; they are also the sweep table's columns.
 INPUT_FIELDS = ("g0", "theta0_deg", "n", "q0", "t_end", "rtol", "atol", "w", "perturbation",
-                "seed")
+                "seed", "model", "slenderness")
 RUN_FIELDS = ("method", "n_used", "status", "t_final", "steps_accepted", "steps_rejected",
               "nfev", "njev", "nlu", "wall_s", "tail_max")
 #: What the end state means (``loopsim.outcomes``).
@@ -35,7 +35,7 @@ SUMMARY_FIELDS = (INPUT_FIELDS + RUN_FIELDS + tuple(d.name for d in diagnostics.
 _FLOAT = pa.float64()
 _INT = pa.int64()
 _SUMMARY_TYPES = {
-    "n": _INT, "seed": _INT, "method": pa.string(), "n_used": _INT, "status": pa.string(),
+    "n": _INT, "seed": _INT, "model": pa.string(), "method": pa.string(), "n_used": _INT, "status": pa.string(),
     "steps_accepted": _INT,
     "steps_rejected": _INT, "nfev": _INT, "njev": _INT, "nlu": _INT,
     "regime": pa.string(), "resolved": pa.bool_(), "determined": pa.bool_(), "twin_nfev": _INT,

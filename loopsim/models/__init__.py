@@ -9,16 +9,20 @@ interface, imported here so its implementations are registered.  A user chooses 
 loop's model by name (:class:`Model`: ``--model``, ``simulate(model=)``).
 """
 import collections
+import functools
 
 import numpy as np
 
+from .. import validation
+from ..config import MAX_SLENDERNESS, MODEL_CHOICES
 from ..jit import entry
-from . import local_sbt, nonlocal_sbt, riccati  # noqa: F401 - importing registers them
+from . import local_sbt, nonlocal_circle, nonlocal_sbt, riccati  # noqa: F401 - registers them
 from .base import (
     auxiliary, for_case, implements, jacobian, monitored_errors, rhs, steady_invariants,
 )
 
-__all__ = ["Model", "LOCAL", "rhs", "jacobian", "monitored_errors",
+__all__ = ["Model", "LOCAL", "choose", "highest_order", "check_order", "make_problem",
+           "case_constants", "case_parameters", "rhs", "jacobian", "monitored_errors",
            "steady_invariants",
            "auxiliary",
            "for_case", "implements", "evaluate", "evaluate_jacobian", "local_sbt", "nonlocal_sbt",
@@ -45,7 +49,45 @@ def evaluate_jacobian(problem, y, jac):
 Model = collections.namedtuple("Model", "name slenderness")
 #: The default: the paper's local slender-body theory.
 LOCAL = Model("local", None)
-_MODULES = {"local": local_sbt, "nonlocal": nonlocal_sbt}
+
+
+def choose(name="local", slenderness=None):
+    """The :class:`Model` of a user's choice, checked: one-line ValueErrors naming the value
+    (the nonlocal model needs a slenderness in (0, ``config.MAX_SLENDERNESS``]; the local
+    one takes none)."""
+    name = validation.check_choice("model", name, MODEL_CHOICES)
+    if name == "local":
+        if slenderness is not None:
+            raise ValueError(f"slenderness applies only to the nonlocal model, got "
+                             f"slenderness={slenderness!r} with model 'local'")
+        return LOCAL
+    if slenderness is None:
+        raise ValueError("the nonlocal model needs slenderness = a/L (filament radius over "
+                         "loop length), e.g. 1e-3")
+    return Model(name, validation.check_real("slenderness", slenderness, 0.0,
+                                             MAX_SLENDERNESS, low_open=True))
+
+
+@functools.lru_cache(maxsize=64)
+def highest_order(model):
+    """The highest truncation order ``model`` can run at (None: no limit): for the nonlocal
+    model, one below the first mode its operator is not positive at on the circle
+    (``nonlocal_circle.first_nonpositive_mode``: ε = 1e-2 gives n ≤ 10, 1e-3 n ≤ 108)."""
+    if model.name == "local":
+        return None
+    return nonlocal_circle.first_nonpositive_mode(model.slenderness) - 1
+
+
+def check_order(model, n, name="n"):
+    """n, or a one-line ValueError when ``model`` cannot run at truncation n."""
+    top = highest_order(model)
+    if top is not None and n > top:
+        raise ValueError(
+            f"{name} = {n} is too high for the nonlocal model at slenderness "
+            f"{model.slenderness:g}: its operator is not positive from mode {top + 1} on "
+            f"(slender-body theory fails at wavelengths below ~9 filament radii); use "
+            f"{name} <= {top} or a smaller slenderness")
+    return n
 
 
 def make_problem(model, n, g0, w):

@@ -9,9 +9,10 @@ import re
 import numpy as np
 import pandas as pd
 
-from .. import integrators, refinement, shapes, validation
+from .. import integrators, models, refinement, shapes, validation
 from ..config import (
     DEFAULT_ATOL, DEFAULT_CHUNK_SIZE, DEFAULT_LENGTH_TOL, DEFAULT_MAX_STEPS, DEFAULT_N_MAX,
+    MODEL_CHOICES,
     DEFAULT_PERTURBATION, DEFAULT_RTOL, DEFAULT_STEADY_INTERVAL, DEFAULT_STEADY_TOL,
     DEFAULT_T_END, DEFAULT_TAIL_TOL, DEFAULT_W,
 )
@@ -45,6 +46,10 @@ def parse_values(text, name, integer=False):
     return [convert(v) for v in values]
 
 
+#: SweepConfig fields left out of ``as_dict`` at these values (the local model).
+UNRECORDED_DEFAULTS = {"model": "local", "slenderness": None}
+
+
 @dataclasses.dataclass
 class SweepConfig:
     """Everything that determines a sweep's results (stored in _sweep.json)."""
@@ -68,6 +73,8 @@ class SweepConfig:
     n_max: int = DEFAULT_N_MAX
     tail_tol: float = DEFAULT_TAIL_TOL
     twin: bool = True  # run each case's stricter twin (loopsim.outcomes: determined or not)
+    model: str = "local"  # the hydrodynamic model (config.MODEL_CHOICES; models.Model)
+    slenderness: float = None  # a/L of the nonlocal model
 
     def step_options(self):
         return integrators.step_options(
@@ -76,7 +83,13 @@ class SweepConfig:
             steady_tol=self.steady_tol)
 
     def as_dict(self):
-        return dataclasses.asdict(self)
+        """The fields as a dict; ``model`` and ``slenderness`` only where not the local
+        model's (so a sweep begun before they existed keeps its fingerprint)."""
+        values = dataclasses.asdict(self)
+        for name, default in UNRECORDED_DEFAULTS.items():
+            if values[name] == default:
+                del values[name]
+        return values
 
     @property
     def n_chunks(self):
@@ -109,7 +122,7 @@ def _cell(path, row, column, value, integer):
 
 
 #: Optional per-case columns of a cases file that override the sweep's option.
-CASE_OVERRIDES = ("method", "rtol", "t_end")
+CASE_OVERRIDES = ("method", "rtol", "t_end", "model", "slenderness")
 #: Every column a cases file may have.
 CASE_COLUMNS = ("g0", "theta0_deg", "n", "seed", "perturbation", "initial",
                 "initial_case_id") + CASE_OVERRIDES
@@ -136,19 +149,19 @@ def _case_row(path, i, row):
                 theta0_deg=_cell(path, i, "theta0_deg", row.theta0_deg, False),
                 n=_cell(path, i, "n", row.n, True), seed=_cell(path, i, "seed", row.seed, True),
                 perturbation=_cell(path, i, "perturbation", row.perturbation, False))
-    for key in ("rtol", "t_end"):
+    for key in ("rtol", "t_end", "slenderness"):
         value = getattr(row, key, None)
         if value is not None and not (isinstance(value, float) and math.isnan(value)):
             case[key] = _cell(path, i, key, value, False)
-    method = getattr(row, "method", None)
-    if method is not None and not isinstance(method, str) and not pd.isna(method):
-        raise ValueError(f"cases file {path!r}, row {i}, column method: must be one of "
-                         f"{', '.join(refinement.METHOD_CHOICES)}, got {method!r}")
-    if isinstance(method, str) and method.strip():
-        if method.strip() not in refinement.METHOD_CHOICES:
-            raise ValueError(f"cases file {path!r}, row {i}, column method: must be one of "
-                             f"{', '.join(refinement.METHOD_CHOICES)}, got {method!r}")
-        case["method"] = method.strip()
+    for key, choices in (("method", refinement.METHOD_CHOICES), ("model", MODEL_CHOICES)):
+        value = getattr(row, key, None)
+        if value is None or (not isinstance(value, str) and pd.isna(value)) or (
+                isinstance(value, str) and not value.strip()):
+            continue
+        if not isinstance(value, str) or value.strip() not in choices:
+            raise ValueError(f"cases file {path!r}, row {i}, column {key}: must be one of "
+                             f"{', '.join(choices)}, got {value!r}")
+        case[key] = value.strip()
     return case
 
 
@@ -157,9 +170,18 @@ def case_option(config, case, key):
     return case.get(key, getattr(config, key))
 
 
+def case_model(config, case):
+    """A case's ``models.Model``: its own model and slenderness (cases-file columns) or the
+    sweep's; a local case has no slenderness."""
+    name = case_option(config, case, "model")
+    return models.choose(name, case_option(config, case, "slenderness")
+                         if name == "nonlocal" else None)
+
+
 def read_cases_file(path, perturbation=DEFAULT_PERTURBATION, n=6):
     """Cases from a CSV or Parquet table: columns g0, theta0_deg (required), n, seed,
-    perturbation, and per case (overriding the sweep's options) method, rtol, t_end."""
+    perturbation, and per case (overriding the sweep's options) method, rtol, t_end,
+    model, slenderness."""
     validation.check_input_file("cases file", path, validation.MAX_CASES_FILE_BYTES)
     limit = validation.MAX_CASES
     try:
@@ -220,8 +242,14 @@ def validate(config):
                     validation.check_real(key, case[key], low=0.0, low_open=True)
             if "method" in case:
                 validation.check_choice("method", case["method"], refinement.METHOD_CHOICES)
+            models.check_order(case_model(config, case), case["n"],
+                               "n_start" if config.n_auto else "n")
         except ValueError as exc:
             raise ValueError(f"case {case_id}: {exc}") from None
+    if config.slenderness is not None and not any(
+            case_option(config, case, "model") == "nonlocal" for case in config.cases):
+        raise ValueError(f"slenderness applies only to the nonlocal model, got slenderness="
+                         f"{config.slenderness!r} and no case of model 'nonlocal'")
     validation.check_real("t_end", config.t_end, low=0.0, low_open=True)
     validation.check_real("rtol", config.rtol, low=0.0, low_open=True)
     validation.check_real("atol", config.atol, low=0.0)

@@ -11,7 +11,7 @@ from .. import (
     _jitcache, api, columns, diagnostics, integrators, io, models, outcomes, refinement, shapes,
     spectral,
 )
-from .cases import case_option
+from .cases import case_model, case_option
 from .chunks import chunk_case_ids
 from .directory import write_piece
 
@@ -35,9 +35,11 @@ def case_method(config, case):
 
 
 def case_ladder(config, case):
-    """The truncation orders a case may use: its n, or with ``n_auto`` the ladder above it."""
+    """The truncation orders a case may use: its n, or with ``n_auto`` the ladder above it
+    (up to n_max, or the case model's highest order: ``api.ladder_top``)."""
     n = case["n"]
-    return refinement.orders(n, max(n, config.n_max)) if config.n_auto else (n,)
+    top = api.ladder_top(case_model(config, case), config.n_max)
+    return refinement.orders(n, max(n, top)) if config.n_auto else (n,)
 
 
 def _result_row(config, case_id, case, x0, x, status_code, counts, worst, wall_s, t_final,
@@ -51,12 +53,14 @@ def _result_row(config, case_id, case, x0, x, status_code, counts, worst, wall_s
                              config.thresholds)
     if not np.all(np.isfinite(x)):
         x = spectral.resize(x0, n_used)  # keep the row finite; the status says why
-    problem = models.local_sbt.make_problem(n_used, case["g0"], config.w)
+    model = case_model(config, case)
+    problem = models.make_problem(model, n_used, case["g0"], config.w)
     u, multiplier = api.velocity_and_multiplier(problem, x)
     inputs = dict(g0=case["g0"], theta0_deg=case["theta0_deg"], n=case["n"],
                   t_end=case_option(config, case, "t_end"),
                   rtol=case_option(config, case, "rtol"), atol=config.atol, w=config.w,
-                  perturbation=case["perturbation"], seed=case["seed"])
+                  perturbation=case["perturbation"], seed=case["seed"], model=model.name,
+                  slenderness=model.slenderness)
     determinacy = (dict(outcomes.NO_TWIN) if twin is None else
                    outcomes.determinacy(end, twin, twin["nfev"], config.thresholds))
     row = api.terminal_summary(
@@ -79,6 +83,7 @@ def _traced_case(config, case_id):
     case = config.cases[case_id]
     method = case_method(config, case)
     start = dict(_start(case), **({"n": "auto", "n_start": case["n"]} if config.n_auto else {}))
+    model = case_model(config, case)
     with warnings.catch_warnings():  # the row says it, and the sweep's summary counts it
         warnings.simplefilter("ignore", api.LoopsimWarning)
         result = api.simulate(
@@ -88,7 +93,8 @@ def _traced_case(config, case_id):
             method=method, max_steps=config.max_steps, length_tol=config.length_tol,
             steady_tol=config.steady_tol if config.early_stop else None,
             steady_interval=config.steady_interval, n_max=config.n_max,
-            tail_tol=config.tail_tol, twin=config.twin)
+            tail_tol=config.tail_tol, twin=config.twin, model=model.name,
+            slenderness=model.slenderness)
     row = _result_row(config, case_id, case, result.x[0], result.x_final, result.status_code,
                       [getattr(result, name) for name in integrators.COUNTS],
                       (result.length_error_max, result.tail_max), result.wall_s,
@@ -101,13 +107,19 @@ def _traced_case(config, case_id):
     return row, io.described(table, columns.TRAJECTORY_COLUMNS)
 
 
+def _group_order(item):
+    """Groups of a chunk in a fixed order (the local model's slenderness None sorts first)."""
+    (model, n, method, rtol), _ = item
+    return (model.name, model.slenderness or 0.0, n, method, rtol)
+
+
 def run_chunk(config, chunk, threads):
     """Integrate one chunk's cases.
 
     Returns (results Table in RESULT_SCHEMA, snapshots Table or None).  Cases
     without snapshots run in the batch kernel (``refinement.integrate_cases``: a fixed
     n is a ladder of one order; parallel over ``threads`` lanes, serial on one), grouped
-    by starting n, method and rtol; their ``wall_s`` is the batch's wall time x threads
+    by model, starting n, method and rtol; their ``wall_s`` is the batch's wall time x threads
     shared in proportion to RHS evaluations (a single case: its own wall time).
     """
     ids = chunk_case_ids(config, chunk)
@@ -116,20 +128,22 @@ def run_chunk(config, chunk, threads):
     for case_id in ids:
         if case_id not in traced:
             case = config.cases[case_id]
-            key = (case["n"], case_method(config, case), case_option(config, case, "rtol"))
+            key = (case_model(config, case), case["n"], case_method(config, case),
+                   case_option(config, case, "rtol"))
             groups.setdefault(key, []).append(case_id)
     start = time.perf_counter()
     compiled = _jitcache.compile_seconds()
     outputs = []
-    for (n, method, rtol), members in sorted(groups.items()):
+    for (model, n, method, rtol), members in sorted(groups.items(), key=_group_order):
         cases = [config.cases[i] for i in members]
         x0 = [shapes.start_shape(**_start(c))[0] for c in cases]
         run = functools.partial(
             refinement.integrate_cases, integrators.METHODS[method],
-            [(c["g0"], config.w) for c in cases], x0,
+            [models.case_parameters(model, c["g0"], config.w) for c in cases], x0,
             [case_option(config, c, "t_end") for c in cases],
             ladder=case_ladder(config, cases[0]),
-            cost=[diagnostics.stability_parameter(c["g0"], c["theta0_deg"]) for c in cases])
+            cost=[diagnostics.stability_parameter(c["g0"], c["theta0_deg"]) for c in cases],
+            model=model)
         options = config.step_options()._replace(rtol=float(rtol))
         result = run(options=options, tail_tol=config.tail_tol)
         twins = None
