@@ -101,10 +101,11 @@ def phase_diagram(frame, ax=None, paper_band=False):
     return fig
 
 
-def growth_rates(n=16, q_values=None, theta0_deg=90.0, w=None, ax=None):
+def growth_rates(n=16, q_values=None, theta0_deg=90.0, w=None, ax=None, model=None):
     """Largest growth rates vs q: the paper's operator, the corrected operator and both
-    sectors of the full Jacobian, with the critical q of each marked."""
-    kwargs = {} if w is None else dict(w=w)
+    sectors of the full Jacobian (of ``model``, a ``models.Model``; default local), with
+    the critical q of each marked."""
+    kwargs = dict({} if w is None else dict(w=w), **({} if model is None else dict(model=model)))
     fig, ax = _axes(ax, (6.4, 4.2))
     q_values = np.linspace(0.0, 20.0, 81) if q_values is None else np.asarray(q_values, float)
     rows = circle.paper_comparison(q_values, n, theta0_deg, **kwargs)
@@ -123,7 +124,9 @@ def growth_rates(n=16, q_values=None, theta0_deg=90.0, w=None, ax=None):
     ax.set_ylim(-15, 15)
     ax.set_xlabel("q = g0 sin θ0 / 3")
     ax.set_ylabel("largest growth rate σ")
-    ax.set_title(f"translating circle, n = {n}")
+    hydrodynamics = "" if model is None or model.name == "local" else (
+        f", nonlocal SBT, ε = {model.slenderness:g}")
+    ax.set_title(f"translating circle, n = {n}{hydrodynamics}")
     ax.legend(frameon=False)
     return fig
 

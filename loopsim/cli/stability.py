@@ -4,7 +4,7 @@ import json
 import math
 
 from ..config import DEFAULT_W
-from .common import HelpFormatter, real, use_agg
+from .common import HelpFormatter, add_model_options, real, use_agg
 
 
 def add_parser(commands):
@@ -37,6 +37,7 @@ def add_parser(commands):
                       help="also the q where a mode of size EPS reaches DETECT at T_END, per sector")
     full.add_argument("--figure", metavar="PNG",
                       help="draw growth rates vs q (paper's operator beside the full sectors)")
+    add_model_options(full)
     paper_group = stability.add_argument_group("the paper's operator (--paper)")
     paper_group.add_argument("--paper", action="store_true",
                              help="the table of the paper's operator for n = 1..--n-max instead")
@@ -46,11 +47,11 @@ def add_parser(commands):
 
 
 FULL_DEFAULTS = dict(n=16, theta0=90.0, w=DEFAULT_W, top=12)
-FULL_ONLY = ("n", "theta0", "w", "q_scan", "g0", "top", "onset", "figure")
+FULL_ONLY = ("n", "theta0", "w", "q_scan", "g0", "top", "onset", "figure", "slenderness")
 
 
 def _cmd_stability_full(args):
-    from .. import plots, sweeps, validation
+    from .. import models, plots, sweeps, validation
     from ..stability import circle, onset, paper
 
     if args.figure is not None:
@@ -67,22 +68,30 @@ def _cmd_stability_full(args):
         raise ValueError(f"--theta0 must be in (0, 90], got {args.theta0}")
     if args.w <= 0.0:
         raise ValueError(f"--w must be > 0, got {args.w}")
+    model = models.choose(args.model, args.slenderness)
+    models.check_order(model, args.n, "--n")
+    if model.name == "nonlocal" and args.theta0 != 90.0:
+        raise ValueError(f"--theta0 {args.theta0:g}: with --model nonlocal the in-plane and "
+                         "out-of-plane sectors decouple only at --theta0 90 (the normal "
+                         "gravity couples them through the nonlocal operator; docs/nonlocal.md)")
+    full = dict(w=args.w, model=model)
     nan_none = lambda v: None if math.isnan(v) else v  # noqa: E731
     out = {
         "operator": "full", "n": args.n, "theta0_deg": args.theta0, "w": args.w,
-        "q_crit_in_plane": nan_none(circle.critical_q(args.n, "in-plane", args.theta0, args.w)),
+        "model": model.name, "slenderness": model.slenderness,
+        "q_crit_in_plane": nan_none(circle.critical_q(args.n, "in-plane", args.theta0, **full)),
         "q_crit_out_of_plane": nan_none(circle.critical_q(args.n, "out-of-plane", args.theta0,
-                                                          args.w)),
+                                                          **full)),
         "q_crit_paper": nan_none(paper.critical_q(args.n)),
         "q_crit_corrected_operator": nan_none(paper.critical_q(args.n, corrected=True)),
     }
     if args.q_scan:
         out["q_scan"] = circle.paper_comparison(
-            sweeps.parse_values(args.q_scan, "--q-scan"), args.n, args.theta0, args.w)
+            sweeps.parse_values(args.q_scan, "--q-scan"), args.n, args.theta0, **full)
     if args.g0 is not None:
         if args.g0 < 0.0:
             raise ValueError(f"--g0 must be >= 0, got {args.g0}")
-        spec = circle.full_spectrum(args.g0, args.theta0, args.n, args.w)
+        spec = circle.full_spectrum(args.g0, args.theta0, args.n, **full)
         top = (spec.sector != "neutral").nonzero()[0][:max(1, args.top)]
         out["spectrum"] = {
             "g0": args.g0, "q": spec.q, "neutral_modes": int((spec.sector == "neutral").sum()),
@@ -96,16 +105,18 @@ def _cmd_stability_full(args):
         eps, t_end, detect = args.onset
         out["onset"] = {"eps": eps, "t_end": t_end, "detect": detect, **{
             f"q_{s.replace('-', '_')}": nan_none(onset.onset_q(
-                eps, t_end, detect, args.n, s, args.theta0, args.w)) for s in circle.SECTORS}}
+                eps, t_end, detect, args.n, s, args.theta0, **full)) for s in circle.SECTORS}}
     if args.figure:
         use_agg()
-        plots.save(plots.growth_rates(args.n, theta0_deg=args.theta0, w=args.w), args.figure, dpi=120)
+        plots.save(plots.growth_rates(args.n, theta0_deg=args.theta0, **full), args.figure,
+                   dpi=120)
         out["figure"] = args.figure
     if args.json:
         print(json.dumps(out))
         return 0
     print(f"# full linearisation about the translating circle, n = {args.n}, "
-          f"theta0 = {args.theta0} deg, w = {args.w}")
+          f"theta0 = {args.theta0} deg, w = {args.w}, model = {model.name}"
+          + (f" (slenderness {model.slenderness:g})" if model.slenderness else ""))
     for key in ("q_crit_in_plane", "q_crit_out_of_plane", "q_crit_paper", "q_crit_corrected_operator"):
         print(f"{key:<26}  {'no crossing' if out[key] is None else f'{out[key]:.11f}'}")
     print(f"# q_crit_paper: {paper.SIGN_NOTE}")
@@ -134,7 +145,8 @@ def command(args):
 
     if not args.paper:
         return _cmd_stability_full(args)
-    given = [key for key in FULL_ONLY if getattr(args, key) is not None]
+    given = [key for key in FULL_ONLY if getattr(args, key) is not None] + (
+        ["model"] if args.model != "local" else [])
     if given:
         raise ValueError(f"--{given[0].replace('_', '-')} applies only to the full linearisation "
                          "(drop --paper)")

@@ -108,12 +108,15 @@ def l2_weights(n):
 
 
 # ---------------------------------------------------------------- Jacobian
-def rhs_jacobian(x, g0, w=DEFAULT_W):
-    """Exact Jacobian dF/dx (3K, 3K) of the spectral RHS at shape x (3, K), acting on
-    x.ravel() (component-major): ``models.local_sbt.loop_jacobian``."""
+def rhs_jacobian(x, g0, w=DEFAULT_W, model=models.LOCAL):
+    """Jacobian dF/dx (3K, 3K) of the spectral RHS at shape x (3, K), acting on x.ravel()
+    (component-major): exact for the local model (``models.local_sbt.loop_jacobian``),
+    by central differences for the nonlocal one (``models.difference_jacobian``)."""
     x = np.ascontiguousarray(x, dtype=float)
     n = (x.shape[1] - 1) // 2
-    problem = local_sbt.make_problem(n, g0, w, local_sbt.make_operators(n))
+    problem = models.make_problem(model, models.check_order(model, n), g0, w)
+    if model.name != "local":
+        return models.difference_jacobian(problem, x.reshape(-1))
     jac = np.empty((x.size, x.size))
     models.evaluate_jacobian(problem, x.reshape(-1), jac)
     return jac
@@ -203,12 +206,13 @@ class CircleLinearisation:
     diagnostics: dict
 
 
-def linearise_circle(n, g0, theta0_deg, w=DEFAULT_W):
-    """Linearise the RHS about the circle tilted by theta0_deg; see :class:`CircleLinearisation`."""
+def linearise_circle(n, g0, theta0_deg, w=DEFAULT_W, model=models.LOCAL):
+    """Linearise the RHS of ``model`` about the circle tilted by theta0_deg; see
+    :class:`CircleLinearisation`."""
     n = _check_n(n)
     th = math.radians(theta0_deg)
     K = 2 * n + 1
-    J = rhs_jacobian(inclined_circle(n, th), g0, w)
+    J = rhs_jacobian(inclined_circle(n, th), g0, w, model)
     R = sector_frame(n, th)
     Jy = R.T @ J @ R
     qp, qs, qo = _bases(n)
@@ -239,7 +243,7 @@ def linearise_circle(n, g0, theta0_deg, w=DEFAULT_W):
     )
 
 
-def neutral_mode_residuals(n, g0, theta0_deg, w=DEFAULT_W):
+def neutral_mode_residuals(n, g0, theta0_deg, w=DEFAULT_W, model=models.LOCAL):
     """For each neutral generator v (unit max-norm): J v, split into its constant part
     (a translation velocity, expected: 0, 0, 0, 0, du0/dθ0, [g0 cos θ0 / 3, 0, 0]) and
     the rest, whose max-norm is the residual.  Returns a list of dicts.
@@ -247,7 +251,7 @@ def neutral_mode_residuals(n, g0, theta0_deg, w=DEFAULT_W):
     n = _check_n(n)
     th = math.radians(theta0_deg)
     K = 2 * n + 1
-    J = rhs_jacobian(inclined_circle(n, th), g0, w)
+    J = rhs_jacobian(inclined_circle(n, th), g0, w, model)
     V = neutral_modes(n, theta0_deg)
     out = []
     for name, v in zip(NEUTRAL_NAMES, V.T):
@@ -302,9 +306,9 @@ def _lift(jbar, offset, size, lam, y):
     return v
 
 
-def full_spectrum(g0, theta0_deg, n, w=DEFAULT_W):
+def full_spectrum(g0, theta0_deg, n, w=DEFAULT_W, model=models.LOCAL):
     """All 3K eigenvalues of J at the circle (g0, θ0), labelled by sector; see :class:`FullSpectrum`."""
-    lin = linearise_circle(n, g0, theta0_deg, w)
+    lin = linearise_circle(n, g0, theta0_deg, w, model)
     K = 2 * lin.n + 1
     wts = np.tile(l2_weights(lin.n), 3)
     frame = sector_frame(lin.n, math.radians(theta0_deg))
@@ -355,21 +359,22 @@ def free_ring_rates(n, sector):
 
 
 @functools.lru_cache(maxsize=64)
-def _pencil(n, theta0_deg, w):
-    """Sector blocks B(q) = B0 + q B1 (J is affine in g0 at the circle)."""
+def _pencil(n, theta0_deg, w, model=models.LOCAL):
+    """Sector blocks B(q) = B0 + q B1 (J is affine in g0 at the circle, in either model: the
+    tension, and so F, is affine in g0 at any fixed shape)."""
     th = math.radians(theta0_deg)
-    lin0 = linearise_circle(n, 0.0, theta0_deg, w)
-    lin1 = linearise_circle(n, 3.0 / math.sin(th), theta0_deg, w)
+    lin0 = linearise_circle(n, 0.0, theta0_deg, w, model)
+    lin1 = linearise_circle(n, 3.0 / math.sin(th), theta0_deg, w, model)
     return {s: (lin0.blocks[s], lin1.blocks[s] - lin0.blocks[s]) for s in SECTORS + ("stretch",)}
 
 
-def sigma(n, theta0_deg, w, sector, q):
+def sigma(n, theta0_deg, w, sector, q, model=models.LOCAL):
     """Largest Re σ of a sector's block at q (from the affine pencil, :func:`sector_growth_rates`)."""
-    b0, b1 = _pencil(n, theta0_deg, w)[sector]
+    b0, b1 = _pencil(n, theta0_deg, w, model)[sector]
     return float(np.max(np.linalg.eigvals(b0 + q * b1).real))
 
 
-def sector_growth_rates(q_values, n, theta0_deg=90.0, w=DEFAULT_W):
+def sector_growth_rates(q_values, n, theta0_deg=90.0, w=DEFAULT_W, model=models.LOCAL):
     """Largest Re σ of each sector ("in-plane", "out-of-plane", "stretch") for each q.
 
     Uses J(q) = J(0) + q (J(q=1) - J(0)), exact because the circle's T0, f0 and
@@ -378,19 +383,23 @@ def sector_growth_rates(q_values, n, theta0_deg=90.0, w=DEFAULT_W):
     n = _check_n(n)
     th = _check_theta_for_q(theta0_deg)
     qs = np.asarray(q_values, dtype=float)
-    return {s: np.array([sigma(n, th, float(w), s, float(q)) for q in qs.ravel()]).reshape(qs.shape)
+    return {s: np.array([sigma(n, th, float(w), s, float(q), model)
+                         for q in qs.ravel()]).reshape(qs.shape)
             for s in SECTORS + ("stretch",)}
 
 
-def critical_q(n, sector, theta0_deg=90.0, w=DEFAULT_W, q_max=60.0, q_step=0.5):
+def critical_q(n, sector, theta0_deg=90.0, w=DEFAULT_W, q_max=60.0, q_step=0.5,
+               model=models.LOCAL):
     """Smallest q > 0 where the sector's largest Re σ crosses 0 (scan, then brentq to 1e-13).
 
-    NaN if there is no crossing on [0, q_max].
+    NaN if there is no crossing on [0, q_max].  ``model``: ``models.Model`` (the nonlocal
+    model's sectors decouple exactly only at θ0 = 90°, docs/nonlocal.md).
     """
     n = _check_n(n)
     check_sector(sector)
     th = _check_theta_for_q(theta0_deg)
-    return first_crossing(functools.partial(sigma, n, th, float(w), sector), q_max, q_step, 1e-13)
+    return first_crossing(lambda q: sigma(n, th, float(w), sector, q, model), q_max, q_step,
+                          1e-13)
 
 
 def critical_q_table(n_values, theta0_deg=90.0, w=DEFAULT_W):
@@ -400,10 +409,11 @@ def critical_q_table(n_values, theta0_deg=90.0, w=DEFAULT_W):
 
 
 # ---------------------------------------------------------------- comparison with the paper
-def paper_comparison(q_values, n, theta0_deg=90.0, w=DEFAULT_W):
+def paper_comparison(q_values, n, theta0_deg=90.0, w=DEFAULT_W, model=models.LOCAL):
     """Rows dict(q, paper, corrected, out_of_plane, in_plane): largest growth rates of the
-    paper's operator and the corrected one (``stability.paper``), and the full Jacobian's sectors."""
-    rates = sector_growth_rates(q_values, n, theta0_deg, w)
+    paper's operator and the corrected one (``stability.paper``), and the full Jacobian's
+    sectors (of ``model``)."""
+    rates = sector_growth_rates(q_values, n, theta0_deg, w, model)
     rows = []
     for i, q in enumerate(np.asarray(q_values, dtype=float).ravel()):
         rows.append(dict(q=float(q), paper=paper.largest_growth_rate(float(q), n),

@@ -8,7 +8,7 @@ import math
 import numpy as np
 from scipy.linalg import eig
 
-from .. import diagnostics, validation
+from .. import diagnostics, models, validation
 from ..config import DEFAULT_W
 from ..shapes import inclined_circle, initial_shape
 from .circle import (
@@ -24,7 +24,8 @@ ONSET_Q_MAX = 59.75
 ONSET_SCAN_STEP = 0.25
 
 
-def onset_q(eps, t_end, detect, n, sector, theta0_deg=90.0, w=DEFAULT_W, q_max=60.0):
+def onset_q(eps, t_end, detect, n, sector, theta0_deg=90.0, w=DEFAULT_W, q_max=60.0,
+            model=models.LOCAL):
     """q at which a mode of initial size eps reaches size detect at t_end:
     eps·exp(σ(q) t_end) = detect, i.e. σ(q) = ln(detect/eps)/t_end.  NaN if never on [0, q_max].
     """
@@ -34,7 +35,7 @@ def onset_q(eps, t_end, detect, n, sector, theta0_deg=90.0, w=DEFAULT_W, q_max=6
     check_sector(sector)
     th = validation.check_tilt("theta0 (for a given q)", theta0_deg, allow_zero=False)
     target = math.log(detect / eps) / t_end
-    fun = lambda q: sigma(n, th, float(w), sector, q) - target  # noqa: E731
+    fun = lambda q: sigma(n, th, float(w), sector, q, model) - target  # noqa: E731
     return first_crossing(fun, q_max, 0.5, 1e-12)
 
 
