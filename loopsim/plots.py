@@ -8,7 +8,7 @@ import os
 import matplotlib.pyplot as plt
 import numpy as np
 
-from . import spectral
+from . import models, spectral
 from .stability import circle, paper
 
 REGIME_STYLE = {
@@ -32,6 +32,23 @@ def orders_text(frame):
     config = (frame.attrs.get("loopsim", {}) or {}).get("sweep_config", {}) or {}
     auto = bool(config.get("n_auto")) or (column == "n_used" and bool((frame["n_used"] != frame["n"]).any()))
     return f"n auto (n_used = {values})" if auto else f"n = {values}"
+
+
+def frame_model(frame):
+    """The ``models.Model`` of a results table's rows (local for a table without the
+    column); ValueError for a table mixing models (one diagram, one model)."""
+    if "model" not in frame or not len(frame):
+        return models.LOCAL
+    pairs = {(m, None if m == "local" else float(e))
+             for m, e in zip(frame["model"], frame["slenderness"])}
+    if len(pairs) > 1:
+        raise ValueError(f"the table mixes models {sorted(pairs, key=str)}: draw one at a time")
+    return models.choose(*pairs.pop())
+
+
+def model_text(model):
+    """'' for the local model, ', nonlocal SBT, ε = 0.001' for the nonlocal one."""
+    return "" if model.name == "local" else f", nonlocal SBT, ε = {model.slenderness:g}"
 
 
 def _axes(ax, figsize):
@@ -62,11 +79,13 @@ def phase_diagram(frame, ax=None, paper_band=False):
     ``outcomes.Thresholds.resolved``; ringed red: not determined), with the curves g0 = 3 q_c / sin θ0 of the
     paper's linear stability (q_c = 14.561, wrong sign) and of the full linearisation of
     the circle at the sweep's largest truncation (``n_used`` for ``--n auto`` rows;
-    in-plane q_c ≈ 8.90, out-of-plane ≈ 10.65).
+    in-plane q_c ≈ 8.90, out-of-plane ≈ 10.65), in the rows' model (nonlocal: its
+    thresholds at θ0 = 90°, drawn as g0 = 3 q_c / sin θ0).
     ``paper_band``: also the paper's empirical in-plane band q = 10.5 and 18.5 (its Fig. 5)."""
     fig, ax = _axes(ax, (6.6, 4.0))
     q_paper = paper.critical_q(20)
     order = int(frame[order_column(frame)].max())
+    model = frame_model(frame)
     resolved = frame["resolved"] if "resolved" in frame else np.ones(len(frame), bool)
     for regime, style in REGIME_STYLE.items():
         failed = style["marker"] == "x"  # a failed case is drawn whether resolved or not
@@ -83,7 +102,7 @@ def phase_diagram(frame, ax=None, paper_band=False):
     ax.plot(theta, 3 * q_paper / np.sin(np.radians(theta)), "k-", lw=1.2,
             label=f"paper's linear\nstability, q = {q_paper:.3f}")
     for sector, style in (("in-plane", "--"), ("out-of-plane", ":")):
-        q_sector = circle.critical_q(max(order, 3), sector)
+        q_sector = circle.critical_q(max(order, 3), sector, model=model)
         ax.plot(theta, 3 * q_sector / np.sin(np.radians(theta)), "k", ls=style, lw=1.2,
                 label=f"full linearisation,\n{sector}, q = {q_sector:.3f}")
     if paper_band:
@@ -95,8 +114,8 @@ def phase_diagram(frame, ax=None, paper_band=False):
     ax.set_ylim(0, 1.05 * frame["g0"].max())
     ax.set_xlabel(r"initial tilt $\theta_0$ (deg)")
     ax.set_ylabel(r"$g_0$ (gravity / stiffness)")
-    ax.set_title(f"sedimentation regimes, {orders_text(frame)}, t = {frame['t_end'].max():g}",
-                 fontsize=10)
+    ax.set_title(f"sedimentation regimes, {orders_text(frame)}, t = {frame['t_end'].max():g}"
+                 + ("" if model.name == "local" else f"\n{model_text(model)[2:]}"), fontsize=10)
     ax.legend(fontsize=8, frameon=False, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     return fig
 
@@ -124,10 +143,26 @@ def growth_rates(n=16, q_values=None, theta0_deg=90.0, w=None, ax=None, model=No
     ax.set_ylim(-15, 15)
     ax.set_xlabel("q = g0 sin θ0 / 3")
     ax.set_ylabel("largest growth rate σ")
-    hydrodynamics = "" if model is None or model.name == "local" else (
-        f", nonlocal SBT, ε = {model.slenderness:g}")
-    ax.set_title(f"translating circle, n = {n}{hydrodynamics}")
+    ax.set_title(f"translating circle, n = {n}{model_text(model or models.LOCAL)}")
     ax.legend(frameon=False)
+    return fig
+
+
+def nonlocal_thresholds(eps_values=(1e-2, 3e-3, 1e-3, 1e-4, 1e-6, 1e-9, 1e-12), n=8, ax=None):
+    """Critical q of the translating circle (θ0 = 90°, in-plane and out-of-plane) under
+    nonlocal SBT against the slenderness ε, with the local model's thresholds (ε → 0)."""
+    fig, ax = _axes(ax, (6.4, 4.2))
+    eps = np.sort(np.asarray(eps_values, dtype=float))
+    for sector, color in (("in-plane", "C3"), ("out-of-plane", "C0")):
+        local = circle.critical_q(n, sector)
+        q = [circle.critical_q(n, sector, model=models.choose("nonlocal", e)) for e in eps]
+        ax.semilogx(eps, q, "o-", color=color, label=f"nonlocal SBT, {sector}")
+        ax.axhline(local, color=color, ls="--", lw=1.0, label=f"local SBT, {sector}: {local:.4f}")
+    ax.invert_xaxis()
+    ax.set_xlabel("slenderness ε = a / L")
+    ax.set_ylabel("critical q = g0 sin θ0 / 3")
+    ax.set_title(f"translating circle at θ0 = 90°, n = {n}", fontsize=10)
+    ax.legend(frameon=False, fontsize=8)
     return fig
 
 

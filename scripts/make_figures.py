@@ -40,12 +40,15 @@ The steps (the runs), with the figures that need them:
   and its stricter-tolerance check);
 * ``seed_cells``: docs/distributions.md's four cells (g0 = 100, 150 x θ0 = 45, 60°),
   16 seeds each at ``--n auto`` with twins: seed_cells (``loopsim summary --figure``);
+* ``nonlocal_eps1e-2``, ``nonlocal_eps1e-3``: the main job's grid at ``--n auto`` under
+  nonlocal SBT (``--model nonlocal --slenderness``; at 1e-2 the ladder ends at n = 10):
+  phase_nonlocal_eps1e-2, phase_nonlocal_eps1e-3 (docs/nonlocal.md);
 * ``resolved_n24`` (only with --n24): 4 cases at fixed n = 24 (radau5, rtol 1e-7), a
   check not drawn.
 
 The figure suite's own runs (all but ``main_job`` and ``seed_cells``) skip the twin
 (``--no-twin``): these figures draw no determinacy, and the twin would cost 1.5-2.5x.
-Fig. 3 needs no run.  Nothing here is random beyond the seeded initial perturbations
+Fig. 3 and nonlocal_thresholds (the circle's critical q against ε) need no run.  Nothing here is random beyond the seeded initial perturbations
 (seed 0 unless stated), so a rerun reproduces the tables.
 
 What was run for the committed figures, and when: docs/figures.md ("Regenerating the
@@ -76,6 +79,8 @@ QUICK_MAIN_JOB = ["--g0", "10:150:3", "--theta0", "10:90:3", "--n", "auto"]
 RESOLVED = ["--n", "auto", "--n-max", "32", "--method", "auto", "--rtol", "1e-7", "--atol", "1e-10"]
 #: A fixed-n check at n = 24 (radau5), not drawn: only with --n24.
 FIXED_N24 = ["--method", "radau5", "--rtol", "1e-7", "--atol", "1e-10"]
+#: The slendernesses of the nonlocal phase diagrams (the main job's grid, docs/nonlocal.md).
+NONLOCAL_SLENDERNESS = ("1e-2",)
 #: Figures of loopsim figures at this resolution; the phase diagrams as sweep --figure draws them.
 DPI, PHASE_DPI = 110, 200
 
@@ -154,6 +159,8 @@ def steps(runs, threads, quick=False, n24=False):
               "--n", "auto", *auto_quick, capped=True),
         sweep("seeds_auto_study", "--g0", "30,60,100", "--theta0", "30,60", "--seeds", "auto",
               "--max-seeds", "4" if quick else "32", "--n", "auto", *auto_quick, capped=True),
+        *(sweep(f"nonlocal_eps{eps}", *main_job, *auto_quick, "--model", "nonlocal",
+                "--slenderness", eps, *lean, capped=True) for eps in NONLOCAL_SLENDERNESS),
     ])
     out["main_job"] = out.pop("phase")  # the README's --out runs/phase, under a clearer name
     if n24:
@@ -166,7 +173,7 @@ def targets(quick=False):
     """{figure stem: (steps it needs, how it is drawn)}: every PNG of docs/figures/.  How:
     ("figures", main step, other steps, loopsim figures' name, its output stem), ("phase",
     step) for a plain phase diagram, ("summary", step) for ``loopsim summary --figure``,
-    or ("stability",)."""
+    ("stability",) or ("nonlocal_stability",)."""
     runs3 = ["g150_t60_n6", "g150_t60_n16", "g150_t60_auto"]
     return {
         "fig1_tension_g60_t30_n16": (["g60_t30_n16"],
@@ -190,6 +197,9 @@ def targets(quick=False):
                           "fig9_phase_n")),
         "phase_main": (["main_job"], ("phase", "main_job")),
         "phase_n6": (["phase_n6"], ("phase", "phase_n6")),
+        **{f"phase_nonlocal_eps{eps}": ([f"nonlocal_eps{eps}"], ("phase", f"nonlocal_eps{eps}"))
+           for eps in NONLOCAL_SLENDERNESS},
+        "nonlocal_thresholds": ([], ("nonlocal_stability",)),
         "seed_cells": (["seed_cells"], ("summary", "seed_cells")),
         "seeds_auto_study": (["seeds_auto_study"], ("summary", "seeds_auto_study")),
         "seed_distributions": (["seeds_n6", "seeds_auto"],
@@ -262,6 +272,9 @@ def draw(name, how, paths, out, work, quick):
         n = 6 if quick else 16
         fig = figures.stability(*figures.stability_data(n=n, n_values=range(3, n + 1)))
         plots.save(fig, target, dpi=DPI)
+    elif kind == "nonlocal_stability":
+        eps = (1e-2, 1e-4) if quick else (1e-2, 3e-3, 1e-3, 1e-4, 1e-6, 1e-9, 1e-12)
+        plots.save(plots.nonlocal_thresholds(eps, n=6 if quick else 8), target, dpi=DPI)
     elif kind == "phase":
         plots.save(plots.phase_diagram(read_results(paths[how[1]])), target, dpi=PHASE_DPI)
     elif kind == "summary":
