@@ -55,14 +55,6 @@ def orders(n_start, n_max):
         (n_max,) if n_max > n_start else ())
 
 
-def model_method(method, model):
-    """The integrator ``method`` as tuned for ``model``: radau5 refreshes a Jacobian by
-    finite differences (the nonlocal model's) less often (``RADAU5_COSTLY_JACOBIAN``)."""
-    if method is integrators.RADAU5 and model.name == "nonlocal":
-        return integrators.RADAU5_COSTLY_JACOBIAN
-    return method
-
-
 def level_options(options, tail_tol, top):
     """Driver options of one level: refine past ``tail_tol``, except at the top order."""
     return options._replace(resolution_tol=np.inf if top else float(tail_tol))
@@ -80,7 +72,6 @@ def integrate_case(method, g0, w, x0, t0, t_end, t_eval, options, ladder, tail_t
     the requested times (NaN where not reached).
     """
     x0 = np.asarray(x0, dtype=float)
-    method = model_method(method, model)
     counts = np.zeros(len(integrators.COUNTS), dtype=np.int64)
     ends_only = bool(np.all((t_eval == t0) | (t_eval == t_end)))
     for level, n in enumerate(ladder):
@@ -114,7 +105,6 @@ def integrate_cases(method, parameters, x0, t_end, options, ladder, tail_tol, co
     + 1); counts summed over the levels; the others those of each case's last level.
     """
     cases = len(x0)
-    method = model_method(method, model)
     x0 = [np.asarray(xb, dtype=float) for xb in x0]
     x = list(x0)
     parameters = np.asarray(parameters, dtype=float).reshape(cases, -1)

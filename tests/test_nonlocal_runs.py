@@ -131,23 +131,3 @@ def test_result_files_written_before_the_model_columns_read_as_local():
     assert read.column("model").to_pylist() == ["local"]
     assert read.column("slenderness").to_pylist() == [None]
 
-
-@pytest.mark.filterwarnings("ignore:not resolved")  # n = 6 keeps it short; the policy is tested
-def test_radau5_refreshes_the_nonlocal_jacobian_less_often():
-    """radau5 on the nonlocal model runs ``RADAU5_COSTLY_JACOBIAN`` (refresh only past a
-    Newton rate of 0.1): ``simulate`` equals the driver with it bit for bit, and it reaches
-    the default policy's state to the tolerance with fewer finite-difference Jacobians."""
-    assert integrators.RADAU5_COSTLY_JACOBIAN.jacobian_rate > integrators.RADAU5.jacobian_rate
-    result = loopsim.simulate(60.0, 60.0, n=6, t_span=(0.0, 0.5), method="radau5", twin=False,
-                              **NONLOCAL)
-    x0 = shapes.start_shape(60.0, 6, None, 0, None, None)[0].ravel()
-    problem = nonlocal_sbt.make_problem(6, 60.0, 10.0, 1e-3)
-    options = integrators.step_options(1e-6, 1e-9)
-    runs = {name: integrators.integrate(method, problem, x0.copy(), 0.0, 0.5, None, options,
-                                        None)
-            for name, method in (("costly", integrators.RADAU5_COSTLY_JACOBIAN),
-                                 ("default", integrators.RADAU5))}
-    np.testing.assert_array_equal(result.x_final.ravel(), runs["costly"][2])
-    assert np.abs(runs["costly"][2] - runs["default"][2]).max() < 1e-6
-    jacobians = integrators.COUNTS.index("njev")
-    assert runs["costly"][3][jacobians] < runs["default"][3][jacobians]

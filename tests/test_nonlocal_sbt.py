@@ -32,8 +32,8 @@ def test_horizontal_ring_sediments_at_johnson_wu_broadside_speed(eps):
     assert np.abs(x - expected).max() < 1e-9
 
 
-def test_radau_with_the_difference_jacobian_follows_rkf45():
-    """A tilted, perturbed loop: radau5 (forward-difference Jacobian) and rkf45 end at the
+def test_radau_with_the_exact_jacobian_follows_rkf45():
+    """A tilted, perturbed loop: radau5 (exact Jacobian) and rkf45 end at the
     same shape to their tolerances."""
     n, g0, eps, t_end = 6, 30.0, 1e-3, 0.2
     x0 = shapes.initial_shape(n, np.radians(30.0), 1e-2, 0)

@@ -18,11 +18,10 @@ from .control import (  # noqa: F401 - the public vocabulary of the package
 )
 from .driver import COUNTS, integrate
 from .explicit import RKF45, Tableau
-from .radau import RADAU5, RADAU5_COSTLY_JACOBIAN, RadauIIA
+from .radau import RADAU5, RadauIIA
 
 #: Integrators by name: the value is the method object passed to :func:`integrate`.
 METHODS = {"rkf45": RKF45, "radau5": RADAU5}
 
-__all__ = ["integrate", "COUNTS", "METHODS", "Tableau", "RadauIIA", "RKF45", "RADAU5",
-           "RADAU5_COSTLY_JACOBIAN", "step_options",
+__all__ = ["integrate", "COUNTS", "METHODS", "Tableau", "RadauIIA", "RKF45", "RADAU5", "step_options",
            "StepOptions", "STATUS_NAMES", "STOP_REASONS", "SUCCESS"]

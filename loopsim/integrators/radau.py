@@ -59,11 +59,6 @@ RadauIIA = collections.namedtuple(
     "newton_failure_factor")
 RADAU5 = RadauIIA(ERROR_ORDER, NEWTON_MAXITER, JACOBIAN_ITERATIONS, JACOBIAN_RATE, HOLD_FACTOR,
                   NEWTON_FAILURE_FACTOR)
-#: The same method for a model whose Jacobian costs many right-hand sides (finite
-#: differences): refreshed only after a Newton contraction rate above 0.1, Hairer's advice
-#: for costly Jacobians (RADAU5's THET).  Measured on the nonlocal loop (n = 12, g0 = 100,
-#: θ0 = 60°, t = 2): 3.7 s against 5.5 s, the same solution to the tolerance.
-RADAU5_COSTLY_JACOBIAN = RADAU5._replace(jacobian_rate=0.1)
 
 
 def _transformation():

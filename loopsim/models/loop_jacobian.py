@@ -1,4 +1,6 @@
-"""The exact Jacobian of the local model's velocity (``loop_maps.loop_velocity``)."""
+"""The exact Jacobians of the loop's velocity, by the chain rule through its column blocks:
+the local model's (``loop_maps.loop_velocity``) and, with the kernel K and its change with
+the shape, the nonlocal one's (``nonlocal_maps.nonlocal_jacobian``)."""
 import numpy as np
 
 from ..jit import kernel
@@ -7,20 +9,38 @@ from .loop_maps import loop_velocity_blocks
 
 @kernel
 def loop_jacobian(x, g0, w, ops, ws, jac):
-    """Exact Jacobian J = ∂u/∂x (3K × 3K, component-major) of :func:`loop_velocity`.
+    """Exact Jacobian J = ∂u/∂x (3K × 3K, component-major) of :func:`loop_velocity`
+    (the local mobility m[f] = f + (x'·f) x': :func:`mobility_jacobian` with 1, 1, 0)."""
+    u = np.empty_like(x)
+    loop_velocity_blocks(x, g0, w, ops, ws, u)  # fills the column blocks and ws.tension
+    mobility_jacobian(w, 1.0, 1.0, 0.0, np.empty((0, 0)), np.empty((3, 0, 0)), np.empty((3, 0)),
+                      ops, ws, jac)
+
+
+@kernel
+def mobility_jacobian(w, isotropic, along, nonlocal_share, weight, direction, position, ops,
+                      ws, jac):
+    """J = ∂u/∂x (3K × 3K, component-major) of the loop velocity with mobility
+
+        m[f] = isotropic f + along (t·f) t + nonlocal_share K[f]     (t = x'),
+
+    K the rule of ``nonlocal_maps`` on the grid, its weight W, direction e and the grid
+    positions (3, M) given (nonlocal_share = 0: the local mobility, no K).
+    ws holds the column blocks at x (``loop_velocity_blocks`` or
+    ``nonlocal_maps.nonlocal_loop_velocity``: force, mobile, dmobile, tension).
 
     The chain rule through the three maps and the least-squares tension
     (derivation: docs/stability.md §1; tested against a NumPy twin in tests/naive.py).
     For the coordinate direction δx = e_c φ_k (δt = e_c φ_k', δκ = e_c φ_k''):
 
-        δf = P[T' δt + T δκ − δx''''],   δm = δf + (δt·f + t·δf) t + (t·f) δt,
+        δf = P[T' δt + T δκ − δx''''],
+        δm = isotropic δf + along [(δt·f + t·δf) t + (t·f) δt]
+             + nonlocal_share (K[δf] + δK[f]),
         δε = δt·(P1 m) + t·(P1 δm) + 2w t·δt,
         δT = −(AᵀA)⁻¹ [Aᵀ δε + δAᵀ r],   δu = F(δm + m_T δT),
 
     with ε = A T + b, r = ε(T) the residual and m_T the tension columns of m.
     """
-    u = np.empty_like(x)
-    loop_velocity_blocks(x, g0, w, ops, ws, u)  # fills the column blocks and ws.tension
     m, k = ops.m, ops.S0.shape[1]
     d = 3 * k
     tau = ws.tension
@@ -70,10 +90,13 @@ def loop_jacobian(x, g0, w, ops, ws, jac):
         for c in range(3):
             for j in range(k):
                 col = c * k + j
-                s_ck = S1[i, j] * f[c, i] + t[c, i] * big_f[i, j]
+                s_ck = along * (S1[i, j] * f[c, i] + t[c, i] * big_f[i, j])
                 for cc in range(3):
                     dm[i, cc, col] = s_ck * t[cc, i]
-                dm[i, c, col] += big_f[i, j] + tf[i] * S1[i, j]
+                dm[i, c, col] += isotropic * big_f[i, j] + along * tf[i] * S1[i, j]
+    if nonlocal_share != 0.0:
+        add_kernel_columns(nonlocal_share, weight, direction, big_f, dm)
+        add_kernel_shape_columns(nonlocal_share, weight, direction, position, t, f, S0, S1, dm)
     pdm = np.dot(P1, dm.reshape((m, 3 * d))).reshape((m, 3, d))
     # δε (M, D)
     deps = np.empty((m, d))
@@ -96,7 +119,9 @@ def loop_jacobian(x, g0, w, ops, ws, jac):
     pre = np.empty((m, 3))
     for i in range(m):
         for c in range(3):
-            pre[i, c] = rho[i, c] + rt[i] * t[c, i]
+            pre[i, c] = isotropic * rho[i, c] + along * rt[i] * t[c, i]
+    if nonlocal_share != 0.0:
+        add_adjoint_kernel(nonlocal_share, weight, direction, rho, pre)
     sig = np.dot(P.T, pre)  # (M, 3)
     rhs_t = np.dot(a.T, deps)  # (K, D): Aᵀ δε
     inner = np.empty((m, k))
@@ -104,13 +129,16 @@ def loop_jacobian(x, g0, w, ops, ws, jac):
     for c in range(3):
         for i in range(m):
             for j in range(k):
-                inner[i, j] = (sig[i, c] * S1[i, j] + rt[i] * ws.force[i, c, j]
-                               + rho[i, c] * tfj[i, j] + r[i] * ws.dmobile[i, c, j])
+                inner[i, j] = (sig[i, c] * S1[i, j] + along * rt[i] * ws.force[i, c, j]
+                               + along * rho[i, c] * tfj[i, j] + r[i] * ws.dmobile[i, c, j])
                 inner2[i, j] = sig[i, c] * S0[i, j]
         block = np.dot(S1.T, inner) + np.dot(S2.T, inner2)  # (K dir, K col) for component c
         for kk in range(k):
             for j in range(k):
                 rhs_t[j, c * k + kk] += block[kk, j]
+    if nonlocal_share != 0.0:
+        add_kernel_shape_adjoint(nonlocal_share, weight, direction, position, t, rho, ws.force,
+                                 S0, S1, rhs_t)
     dtau = -np.linalg.solve(np.dot(a.T, a), rhs_t)  # (K, D)
     # δu = F (δm + m_T δT), then arrange as J[(c', k'), (c, k)]
     m_t = np.empty((m * 3, k))
@@ -124,3 +152,158 @@ def loop_jacobian(x, g0, w, ops, ws, jac):
         for kk in range(k):
             for col in range(d):
                 jac[cc * k + kk, col] = du[kk, cc, col]
+
+
+@kernel
+def add_kernel_columns(share, weight, direction, big_f, dm):
+    """dm[i, a, c K + j] += share K[e_c big_f[:, j]](s_i)_a: the kernel on the force change
+    of every coordinate direction, K[g]_i = Σ_l W_il [g_l + e_il (e_il·g_l)]."""
+    m, k = big_f.shape
+    block = np.empty((3 * m, m))
+    for c in range(3):
+        for i in range(m):
+            for a in range(3):
+                for l in range(m):
+                    block[3 * i + a, l] = weight[i, l] * (
+                        (1.0 if a == c else 0.0) + direction[a, i, l] * direction[c, i, l])
+        columns = np.dot(block, big_f)  # (3M, K)
+        for i in range(m):
+            for a in range(3):
+                for j in range(k):
+                    dm[i, a, c * k + j] += share * columns[3 * i + a, j]
+
+
+@kernel
+def add_adjoint_kernel(share, weight, direction, rho, pre):
+    """pre[l] += share (Kᵀ rho)_l = share Σ_i W_il [rho_i + e_il (e_il·rho_i)] (rho (M, 3))."""
+    m = rho.shape[0]
+    for l in range(m):
+        for i in range(m):
+            w_il = weight[i, l]
+            along = w_il * (direction[0, i, l] * rho[i, 0] + direction[1, i, l] * rho[i, 1]
+                            + direction[2, i, l] * rho[i, 2])
+            for a in range(3):
+                pre[l, a] += share * (w_il * rho[i, a] + along * direction[a, i, l])
+
+
+@kernel
+def inverse_distances(position):
+    """invR (M, M): 1/|x_l − x_i| off the diagonal, 0 on it."""
+    m = position.shape[1]
+    inverse = np.zeros((m, m))
+    for l in range(m):
+        for i in range(l + 1, m):
+            d0 = position[0, l] - position[0, i]
+            d1 = position[1, l] - position[1, i]
+            d2 = position[2, l] - position[2, i]
+            inverse[l, i] = 1.0 / np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+            inverse[i, l] = inverse[l, i]
+    return inverse
+
+
+@kernel
+def kernel_shape_term(weight, direction, c, l, i, g, out):
+    """out = H^c_li g = W_li [−e_c g + ê_c (e·g) + e g_c − 3 e_c e (e·g)], e = e_li: the
+    derivative of W_li [g + e (e·g)] along R_li = x_l − x_i in component c, times |R_li|
+    (and along x'_l, times |x'_l|, on the diagonal).  H^c_li is symmetric."""
+    e0 = direction[0, l, i]
+    e1 = direction[1, l, i]
+    e2 = direction[2, l, i]
+    ec = direction[c, l, i]
+    eg = e0 * g[0] + e1 * g[1] + e2 * g[2]
+    w = weight[l, i]
+    out[0] = w * (-ec * g[0] + e0 * g[c] - 3.0 * ec * e0 * eg)
+    out[1] = w * (-ec * g[1] + e1 * g[c] - 3.0 * ec * e1 * eg)
+    out[2] = w * (-ec * g[2] + e2 * g[c] - 3.0 * ec * e2 * eg)
+    out[c] += w * eg
+
+
+@kernel
+def add_kernel_shape_columns(share, weight, direction, position, tangent, f, S0, S1, dm):
+    """dm[l, a, c K + k] += share δK[f]_l,a for δx = e_c φ_k, the kernel's own change with
+    the shape acting on the force f (3, M) at the solved tension:
+
+        δK[f]_l = Σ_{i≠l} (φ_k(s_l) − φ_k(s_i)) H^c_li f_i / |R_li| + φ_k'(s_l) H^c_ll f_l / |x'_l|
+
+    (:func:`kernel_shape_term`; δR_li = e_c (φ_k(s_l) − φ_k(s_i)), δx'_l = e_c φ_k'(s_l))."""
+    m, k = S0.shape
+    inverse = inverse_distances(position)
+    scaled = np.empty((3 * m, m))  # H^c_li f_i / |R_li|, row (l, a)
+    diagonal = np.empty((3, m))
+    row_sum = np.empty((3, m))
+    g = np.empty(3)
+    h = np.empty(3)
+    for c in range(3):
+        for l in range(m):
+            for a in range(3):
+                row_sum[a, l] = 0.0
+            for i in range(m):
+                for a in range(3):
+                    g[a] = f[a, i]
+                kernel_shape_term(weight, direction, c, l, i, g, h)
+                if i == l:
+                    speed = np.sqrt(tangent[0, l] ** 2 + tangent[1, l] ** 2 + tangent[2, l] ** 2)
+                    for a in range(3):
+                        diagonal[a, l] = h[a] / speed
+                        scaled[3 * l + a, i] = 0.0
+                else:
+                    for a in range(3):
+                        scaled[3 * l + a, i] = h[a] * inverse[l, i]
+                        row_sum[a, l] += scaled[3 * l + a, i]
+        mixed = np.dot(scaled, S0)  # Σ_i scaled_(l,a),i φ_k(s_i)
+        for l in range(m):
+            for a in range(3):
+                for j in range(k):
+                    dm[l, a, c * k + j] += share * (
+                        S0[l, j] * row_sum[a, l] - mixed[3 * l + a, j]
+                        + S1[l, j] * diagonal[a, l])
+
+
+@kernel
+def add_kernel_shape_adjoint(share, weight, direction, position, tangent, rho, force, S0, S1,
+                             rhs_t):
+    """rhs_t[j, c K + k] += share Σ_l rho_l · δK[f_j]_l, the tension columns' part of δAᵀ r
+    from the kernel's change with the shape (f_j = force[:, :, j], j < K; δK as in
+    :func:`add_kernel_shape_columns`).  With H symmetric, Σ_l rho_l·δK[f_j]_l =
+    Σ_i z_i · f_j,i,  z_i = Σ_{l≠i} (φ_k(s_l) − φ_k(s_i)) H^c_li rho_l / |R_li|
+    + φ_k'(s_i) H^c_ii rho_i / |x'_i|."""
+    m, k = S0.shape
+    inverse = inverse_distances(position)
+    scaled = np.empty((3 * m, m))  # H^c_li rho_l / |R_li|, row (i, a), column l
+    diagonal = np.empty((3, m))
+    col_sum = np.empty((3, m))
+    g = np.empty(3)
+    h = np.empty(3)
+    z = np.empty((3 * m, k))
+    columns = np.empty((3 * m, k))
+    for i in range(m):
+        for a in range(3):
+            for j in range(k):
+                columns[3 * i + a, j] = force[i, a, j]
+    for c in range(3):
+        for i in range(m):
+            for a in range(3):
+                col_sum[a, i] = 0.0
+            for l in range(m):
+                for a in range(3):
+                    g[a] = rho[l, a]
+                kernel_shape_term(weight, direction, c, l, i, g, h)
+                if i == l:
+                    speed = np.sqrt(tangent[0, i] ** 2 + tangent[1, i] ** 2 + tangent[2, i] ** 2)
+                    for a in range(3):
+                        diagonal[a, i] = h[a] / speed
+                        scaled[3 * i + a, l] = 0.0
+                else:
+                    for a in range(3):
+                        scaled[3 * i + a, l] = h[a] * inverse[l, i]
+                        col_sum[a, i] += scaled[3 * i + a, l]
+        mixed = np.dot(scaled, S0)  # Σ_l scaled_(i,a),l φ_k(s_l)
+        for i in range(m):
+            for a in range(3):
+                for j in range(k):
+                    z[3 * i + a, j] = (mixed[3 * i + a, j] - S0[i, j] * col_sum[a, i]
+                                       + S1[i, j] * diagonal[a, i])
+        block = np.dot(columns.T, z)  # (tension column j, direction k)
+        for j in range(k):
+            for kk in range(k):
+                rhs_t[j, c * k + kk] += share * block[j, kk]

@@ -16,6 +16,7 @@ density on the fluid, grid values component-major (3, m)).
 import numpy as np
 
 from ..jit import kernel
+from .loop_jacobian import mobility_jacobian
 from .loop_maps import force_map, length_creation_map, shape_on_grid, velocity_from_blocks
 from .nonlocal_operator import LOG_4_OVER_PI
 
@@ -130,3 +131,15 @@ def nonlocal_loop_velocity(x, g0, w, c, singular, ops, ws, position, weight, dir
     nonlocal_velocity_map(c, weight, direction, ws)
     length_creation_map(w, ops, ws)
     velocity_from_blocks(ops, ws, u_out)
+
+
+@kernel
+def nonlocal_jacobian(x, g0, w, c, singular, ops, ws, position, weight, direction, jac):
+    """Exact Jacobian J = ∂u/∂x (3K × 3K, component-major) of :func:`nonlocal_loop_velocity`:
+    the chain rule of ``loop_jacobian.mobility_jacobian`` for the mobility
+    m[f] = (1/c)[(c+1) f + (c−3)(x'·f) x' + K[f]], the rule's change with the shape (W and
+    e through the grid positions and x') included."""
+    u = np.empty_like(x)
+    nonlocal_loop_velocity(x, g0, w, c, singular, ops, ws, position, weight, direction, u)
+    mobility_jacobian(w, (c + 1.0) / c, (c - 3.0) / c, 1.0 / c, weight, direction, position,
+                      ops, ws, jac)

@@ -4,7 +4,7 @@ problem type :class:`NonlocalProblem` (docs/nonlocal.md).
 The same state, force, penalty and least-squares tension as the local model; the
 velocity u = (1/c)(Λ + K)[f] (c = −2 log ε, ε = a/L) on the local model's 4n + 1 grid
 (``nonlocal_maps.nonlocal_loop_velocity``), which tends to the local model as c → ∞.
-The Jacobian is by forward differences (3K right-hand sides).  Chosen with
+The Jacobian is exact (``nonlocal_maps.nonlocal_jacobian``).  Chosen with
 ``model="nonlocal"`` and ``slenderness=ε`` (``models.Model``) in ``simulate``, sweeps and
 the command line.
 """
@@ -12,13 +12,12 @@ import collections
 
 import numpy as np
 
-from ..linalg import copy_into
 from . import local_sbt
 from .base import (
     auxiliary, for_case, implements, jacobian, monitored_errors, rhs, steady_invariants,
 )
 from .loop_maps import LoopOperators, make_operators, make_workspace
-from .nonlocal_maps import nonlocal_loop_velocity
+from .nonlocal_maps import nonlocal_jacobian, nonlocal_loop_velocity
 from .nonlocal_operator import singular_weights, slenderness_constant  # noqa: F401 - re-exported
 
 #: The problem: g0, w and c = −2 log ε; the local model's operators and workspace; the
@@ -32,8 +31,6 @@ PARAMETERS = ("g0", "w", "c")
 NonlocalConstants = collections.namedtuple(
     "NonlocalConstants", LoopOperators._fields + ("singular",))
 _OPERATOR_FIELDS = len(LoopOperators._fields)
-#: Relative step of the forward-difference Jacobian: sqrt of the machine epsilon.
-DIFFERENCE_STEP = float(np.sqrt(np.finfo(float).eps))
 
 
 def make_problem(n, g0, w, eps, ops=None):
@@ -76,18 +73,12 @@ def _nonlocal_rhs(problem, y, dydt):
 
 @implements(jacobian, NonlocalProblem)
 def _nonlocal_jacobian(problem, y, f, jac, work_y, work_f):
-    """Forward differences, column j with step DIFFERENCE_STEP max(1, |y_j|); returns the
-    RHS evaluations (3K)."""
-    size = y.shape[0]
-    copy_into(work_y, y)
-    for j in range(size):
-        step = DIFFERENCE_STEP * max(1.0, abs(y[j]))
-        work_y[j] = y[j] + step
-        rhs(problem, work_y, work_f)
-        for i in range(size):
-            jac[i, j] = (work_f[i] - f[i]) / step
-        work_y[j] = y[j]
-    return size
+    """The exact Jacobian (``nonlocal_maps.nonlocal_jacobian``); one velocity inside."""
+    k = y.shape[0] // 3
+    nonlocal_jacobian(y.reshape((3, k)), problem.g0, problem.w, problem.c, problem.singular,
+                      problem.ops, problem.ws, problem.position, problem.weight,
+                      problem.direction, jac)
+    return 1
 
 
 for _generic, _implementation in ((monitored_errors, local_sbt.loop_errors),

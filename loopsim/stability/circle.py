@@ -110,13 +110,11 @@ def l2_weights(n):
 # ---------------------------------------------------------------- Jacobian
 def rhs_jacobian(x, g0, w=DEFAULT_W, model=models.LOCAL):
     """Jacobian dF/dx (3K, 3K) of the spectral RHS at shape x (3, K), acting on x.ravel()
-    (component-major): exact for the local model (``models.local_sbt.loop_jacobian``),
-    by central differences for the nonlocal one (``models.difference_jacobian``)."""
+    (component-major): the model's exact Jacobian (``local_sbt.loop_jacobian``,
+    ``nonlocal_maps.nonlocal_jacobian``)."""
     x = np.ascontiguousarray(x, dtype=float)
     n = (x.shape[1] - 1) // 2
     problem = models.make_problem(model, models.check_order(model, n), g0, w)
-    if model.name != "local":
-        return models.difference_jacobian(problem, x.reshape(-1))
     jac = np.empty((x.size, x.size))
     models.evaluate_jacobian(problem, x.reshape(-1), jac)
     return jac
