@@ -131,3 +131,21 @@ def test_result_files_written_before_the_model_columns_read_as_local():
     assert read.column("model").to_pylist() == ["local"]
     assert read.column("slenderness").to_pylist() == [None]
 
+
+
+def test_unresolved_rows_at_the_models_highest_order_get_no_larger_n_advice():
+    """The sweep's advice for unresolved rows: a larger n, except for rows already at their
+    model's highest order (ε = 1e-2: n = 10), for which no larger n exists."""
+    import pandas as pd
+
+    from loopsim.cli.sweep import refinement_advice
+
+    config = sweeps.SweepConfig(cases=sweeps.grid_cases([10.0], [30.0], [6], 1), n_auto=True)
+    rows = lambda *cases: pd.DataFrame(cases, columns=["model", "slenderness", "n_used"])
+    capped = refinement_advice(config, rows(("nonlocal", 1e-2, 10), ("nonlocal", 1e-2, 10)))
+    assert "highest order" in capped and "--n-max" not in capped
+    mixed = refinement_advice(config, rows(("nonlocal", 1e-2, 10), ("local", np.nan, 32),
+                                            ("nonlocal", 1e-3, 32)))
+    assert "--n-max than 32" in mixed and "1 of them are at their model's highest" in mixed
+    plain = refinement_advice(config, rows(("local", np.nan, 32)))
+    assert "--n-max than 32" in plain and "highest" not in plain

@@ -10,6 +10,27 @@ from .common import (
 )
 
 
+def refinement_advice(config, unresolved):
+    """What to rerun unresolved rows with: a larger n, unless their model has none (nonlocal
+    SBT's highest order, ``models.highest_order``, already reached)."""
+    from .. import models
+
+    tops = [models.highest_order(models.choose(name, eps if name == "nonlocal" else None))
+            for name, eps in zip(unresolved["model"], unresolved["slenderness"])]
+    capped = sum(top is not None and used >= top for top, used in zip(tops, unresolved["n_used"]))
+    if config.n_auto:
+        advice = (f"rerun them with a larger --n-max than {config.n_max} (a cases file of their "
+                  f"g0, theta0_deg and seed)")
+    else:
+        advice = "rerun them with a larger --n or --n auto"
+    if capped == len(unresolved):
+        return ("they are at their model's highest order (nonlocal SBT's short-wave limit, "
+                "docs/nonlocal.md): no larger n exists; a smaller --slenderness resolves more")
+    if capped:
+        return f"{advice}; {capped} of them are at their model's highest order, beyond any n"
+    return advice
+
+
 def add_parser(commands):
     """The ``sweep`` command and its options."""
     sweep = commands.add_parser(
@@ -255,9 +276,7 @@ def command(args):
         print(f"{len(unresolved)} of {len(frame)} cases NOT resolved at their n (transient length "
               f"error > {config.thresholds.resolved_length_error:g} or spectral tail along the "
               f"run > {config.thresholds.resolved_tail:g}; column 'resolved'): their "
-              f"terminal tilt and shape are not converged; rerun them with "
-              + (f"a larger --n-max than {config.n_max} (a cases file of their g0, theta0_deg "
-                 f"and seed)" if config.n_auto else "a larger --n or --n auto")
+              f"terminal tilt and shape are not converged; " + refinement_advice(config, unresolved)
               + " (regimes among them: " + ", ".join(
                   f"{k} {v}" for k, v in sorted(unresolved["regime"].value_counts().items())) + ")")
     undetermined = frame[frame["determined"].eq(False)]
