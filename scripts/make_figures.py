@@ -42,13 +42,15 @@ The steps (the runs), with the figures that need them:
   16 seeds each at ``--n auto`` with twins: seed_cells (``loopsim summary --figure``);
 * ``nonlocal_eps1e-2``, ``nonlocal_eps1e-3``: the main job's grid at ``--n auto`` under
   nonlocal SBT (``--model nonlocal --slenderness``; at 1e-2 the ladder ends at n = 10):
-  phase_nonlocal_eps1e-2, phase_nonlocal_eps1e-3 (docs/nonlocal.md);
+  phase_nonlocal_eps1e-2, phase_nonlocal_eps1e-3, and with ``main_job``
+  nonlocal_outcomes (docs/nonlocal.md);
 * ``resolved_n24`` (only with --n24): 4 cases at fixed n = 24 (radau5, rtol 1e-7), a
   check not drawn.
 
 The figure suite's own runs (all but ``main_job`` and ``seed_cells``) skip the twin
 (``--no-twin``): these figures draw no determinacy, and the twin would cost 1.5-2.5x.
-Fig. 3 and nonlocal_thresholds (the circle's critical q against ε) need no run.  Nothing here is random beyond the seeded initial perturbations
+Fig. 3 and nonlocal_thresholds (the circle's critical q against ε) need no run.  Nothing
+here is random beyond the seeded initial perturbations
 (seed 0 unless stated), so a rerun reproduces the tables.
 
 What was run for the committed figures, and when: docs/figures.md ("Regenerating the
@@ -173,8 +175,10 @@ def targets(quick=False):
     """{figure stem: (steps it needs, how it is drawn)}: every PNG of docs/figures/.  How:
     ("figures", main step, other steps, loopsim figures' name, its output stem), ("phase",
     step) for a plain phase diagram, ("summary", step) for ``loopsim summary --figure``,
-    ("stability",) or ("nonlocal_stability",)."""
+    ("stability",), ("nonlocal_stability",), or ("models", step, step, ...) for
+    ``plots.model_outcomes`` (one column per step's model)."""
     runs3 = ["g150_t60_n6", "g150_t60_n16", "g150_t60_auto"]
+    nonlocal_steps = [f"nonlocal_eps{eps}" for eps in NONLOCAL_SLENDERNESS]
     return {
         "fig1_tension_g60_t30_n16": (["g60_t30_n16"],
                                      ("figures", "seeds_n6", ["g60_t30_n16"], "tension",
@@ -200,6 +204,8 @@ def targets(quick=False):
         **{f"phase_nonlocal_eps{eps}": ([f"nonlocal_eps{eps}"], ("phase", f"nonlocal_eps{eps}"))
            for eps in NONLOCAL_SLENDERNESS},
         "nonlocal_thresholds": ([], ("nonlocal_stability",)),
+        "nonlocal_outcomes": (["main_job", *nonlocal_steps],
+                              ("models", "main_job", *nonlocal_steps)),
         "seed_cells": (["seed_cells"], ("summary", "seed_cells")),
         "seeds_auto_study": (["seeds_auto_study"], ("summary", "seeds_auto_study")),
         "seed_distributions": (["seeds_n6", "seeds_auto"],
@@ -275,6 +281,9 @@ def draw(name, how, paths, out, work, quick):
     elif kind == "nonlocal_stability":
         eps = (1e-2, 1e-4) if quick else (1e-2, 3e-3, 1e-3, 1e-4, 1e-6, 1e-9, 1e-12)
         plots.save(plots.nonlocal_thresholds(eps, n=6 if quick else 8), target, dpi=DPI)
+    elif kind == "models":
+        frames = [read_results(paths[step]) for step in how[1:]]
+        plots.save(plots.model_outcomes(frames), target, dpi=DPI)
     elif kind == "phase":
         plots.save(plots.phase_diagram(read_results(paths[how[1]])), target, dpi=PHASE_DPI)
     elif kind == "summary":

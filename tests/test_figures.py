@@ -156,6 +156,32 @@ def test_phase_diagram_of_n_auto_rows_names_n_used_and_draws_its_linearisation()
     assert any(f"q = {q_in_plane:.3f}" in text for text in labels)
 
 
+def test_nonlocal_tables_draw_their_models_thresholds_side_by_side():
+    """A nonlocal table's phase diagram and outcome columns draw the nonlocal model's
+    thresholds (θ0 = 90°) and name ε; one outcome column per table; mixing models in one
+    table is refused."""
+    from loopsim import models
+    from loopsim.stability import circle
+
+    local = table()
+    nonlocal_table = table().assign(model="nonlocal", slenderness=1e-3)
+    model = models.choose("nonlocal", 1e-3)
+    q_in = circle.critical_q(N, "in-plane", model=model)
+    fig = plots.phase_diagram(nonlocal_table)
+    assert "ε = 0.001" in fig.axes[0].get_title()
+    assert any(f"q = {q_in:.3f}" in t.get_text() for t in fig.axes[0].get_legend().get_texts())
+    fig = plots.model_outcomes([local, nonlocal_table])
+    assert len(fig.axes) == 4
+    lines = lambda ax: sorted(round(line.get_xdata()[0], 6) for line in ax.get_lines())
+    assert lines(fig.axes[2]) == sorted(round(circle.critical_q(N, s), 6)
+                                        for s in ("in-plane", "out-of-plane"))
+    assert round(q_in, 6) in lines(fig.axes[3])
+    assert "nonlocal SBT, ε = 0.001" in fig.axes[1].get_title()
+    with pytest.raises(ValueError, match="mixes models"):
+        plots.phase_diagram(pd.concat([local.assign(model="local", slenderness=np.nan),
+                                       nonlocal_table]))
+
+
 def test_phase_diagram_paper_band_adds_the_two_empirical_curves():
     frame = table()
     plain = plots.phase_diagram(frame)

@@ -228,35 +228,13 @@ def add_kernel_shape_columns(share, weight, direction, position, tangent, f, S0,
     (:func:`kernel_shape_term`; δR_li = e_c (φ_k(s_l) − φ_k(s_i)), δx'_l = e_c φ_k'(s_l))."""
     m, k = S0.shape
     inverse = inverse_distances(position)
-    scaled = np.empty((3 * m, m))  # H^c_li f_i / |R_li|, row (l, a)
-    diagonal = np.empty((3, m))
-    row_sum = np.empty((3, m))
-    g = np.empty(3)
-    h = np.empty(3)
+    change = np.empty((3 * m, k))
     for c in range(3):
-        for l in range(m):
-            for a in range(3):
-                row_sum[a, l] = 0.0
-            for i in range(m):
-                for a in range(3):
-                    g[a] = f[a, i]
-                kernel_shape_term(weight, direction, c, l, i, g, h)
-                if i == l:
-                    speed = np.sqrt(tangent[0, l] ** 2 + tangent[1, l] ** 2 + tangent[2, l] ** 2)
-                    for a in range(3):
-                        diagonal[a, l] = h[a] / speed
-                        scaled[3 * l + a, i] = 0.0
-                else:
-                    for a in range(3):
-                        scaled[3 * l + a, i] = h[a] * inverse[l, i]
-                        row_sum[a, l] += scaled[3 * l + a, i]
-        mixed = np.dot(scaled, S0)  # Σ_i scaled_(l,a),i φ_k(s_i)
+        shape_change(weight, direction, inverse, tangent, c, f, False, S0, S1, change)
         for l in range(m):
             for a in range(3):
                 for j in range(k):
-                    dm[l, a, c * k + j] += share * (
-                        S0[l, j] * row_sum[a, l] - mixed[3 * l + a, j]
-                        + S1[l, j] * diagonal[a, l])
+                    dm[l, a, c * k + j] += share * change[3 * l + a, j]
 
 
 @kernel
@@ -269,11 +247,7 @@ def add_kernel_shape_adjoint(share, weight, direction, position, tangent, rho, f
     + φ_k'(s_i) H^c_ii rho_i / |x'_i|."""
     m, k = S0.shape
     inverse = inverse_distances(position)
-    scaled = np.empty((3 * m, m))  # H^c_li rho_l / |R_li|, row (i, a), column l
-    diagonal = np.empty((3, m))
-    col_sum = np.empty((3, m))
-    g = np.empty(3)
-    h = np.empty(3)
+    field = rho.T.copy()
     z = np.empty((3 * m, k))
     columns = np.empty((3 * m, k))
     for i in range(m):
@@ -281,29 +255,48 @@ def add_kernel_shape_adjoint(share, weight, direction, position, tangent, rho, f
             for j in range(k):
                 columns[3 * i + a, j] = force[i, a, j]
     for c in range(3):
-        for i in range(m):
-            for a in range(3):
-                col_sum[a, i] = 0.0
-            for l in range(m):
-                for a in range(3):
-                    g[a] = rho[l, a]
-                kernel_shape_term(weight, direction, c, l, i, g, h)
-                if i == l:
-                    speed = np.sqrt(tangent[0, i] ** 2 + tangent[1, i] ** 2 + tangent[2, i] ** 2)
-                    for a in range(3):
-                        diagonal[a, i] = h[a] / speed
-                        scaled[3 * i + a, l] = 0.0
-                else:
-                    for a in range(3):
-                        scaled[3 * i + a, l] = h[a] * inverse[l, i]
-                        col_sum[a, i] += scaled[3 * i + a, l]
-        mixed = np.dot(scaled, S0)  # Σ_l scaled_(i,a),l φ_k(s_l)
-        for i in range(m):
-            for a in range(3):
-                for j in range(k):
-                    z[3 * i + a, j] = (mixed[3 * i + a, j] - S0[i, j] * col_sum[a, i]
-                                       + S1[i, j] * diagonal[a, i])
+        shape_change(weight, direction, inverse, tangent, c, field, True, S0, S1, z)
         block = np.dot(columns.T, z)  # (tension column j, direction k)
         for j in range(k):
             for kk in range(k):
                 rhs_t[j, c * k + kk] += share * block[j, kk]
+
+
+@kernel
+def shape_change(weight, direction, inverse, tangent, c, field, adjoint, S0, S1, out):
+    """out (3M, K), row (p, a), column k: for δx = e_c φ_k,
+
+        Σ_{q≠p} (φ_k(s_l) − φ_k(s_i)) (H^c_li g_q)_a / |R_li| + φ_k'(s_p) (H^c_pp g_p)_a / |x'_p|,
+
+    g_q = field[:, q] (3, M), with (l, i) = (p, q): δK[field] at s_p; or, ``adjoint``,
+    (l, i) = (q, p): the z_p of :func:`add_kernel_shape_adjoint`."""
+    m, k = S0.shape
+    scaled = np.empty((3 * m, m))  # (H g_q)_a / |R|, row (p, a), column q
+    sums = np.zeros((3, m))
+    diagonal = np.empty((3, m))
+    g = np.empty(3)
+    h = np.empty(3)
+    for p in range(m):
+        for q in range(m):
+            for a in range(3):
+                g[a] = field[a, q]
+            if adjoint:
+                kernel_shape_term(weight, direction, c, q, p, g, h)
+            else:
+                kernel_shape_term(weight, direction, c, p, q, g, h)
+            if p == q:
+                speed = np.sqrt(tangent[0, p] ** 2 + tangent[1, p] ** 2 + tangent[2, p] ** 2)
+                for a in range(3):
+                    diagonal[a, p] = h[a] / speed
+                    scaled[3 * p + a, q] = 0.0
+            else:
+                for a in range(3):
+                    scaled[3 * p + a, q] = h[a] * inverse[p, q]
+                    sums[a, p] += scaled[3 * p + a, q]
+    mixed = np.dot(scaled, S0)  # Σ_q scaled_(p,a),q φ_k(s_q)
+    sign = -1.0 if adjoint else 1.0  # φ_k(s_l) − φ_k(s_i) = ±(φ_k(s_p) − φ_k(s_q))
+    for p in range(m):
+        for a in range(3):
+            for j in range(k):
+                out[3 * p + a, j] = (sign * (S0[p, j] * sums[a, p] - mixed[3 * p + a, j])
+                                     + S1[p, j] * diagonal[a, p])
