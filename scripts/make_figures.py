@@ -82,7 +82,7 @@ RESOLVED = ["--n", "auto", "--n-max", "32", "--method", "auto", "--rtol", "1e-7"
 #: A fixed-n check at n = 24 (radau5), not drawn: only with --n24.
 FIXED_N24 = ["--method", "radau5", "--rtol", "1e-7", "--atol", "1e-10"]
 #: The slendernesses of the nonlocal phase diagrams (the main job's grid, docs/nonlocal.md).
-NONLOCAL_SLENDERNESS = ("1e-2",)
+NONLOCAL_SLENDERNESS = ("1e-2", "1e-3")
 #: Figures of loopsim figures at this resolution; the phase diagrams as sweep --figure draws them.
 DPI, PHASE_DPI = 110, 200
 
