@@ -13,8 +13,7 @@ def loop_jacobian(x, g0, w, ops, ws, jac):
     (the local mobility m[f] = f + (x'·f) x': :func:`mobility_jacobian` with 1, 1, 0)."""
     u = np.empty_like(x)
     loop_velocity_blocks(x, g0, w, ops, ws, u)  # fills the column blocks and ws.tension
-    mobility_jacobian(w, 1.0, 1.0, 0.0, np.empty((0, 0)), np.empty((3, 0, 0)), np.empty((3, 0)),
-                      ops, ws, jac)
+    mobility_jacobian(w, 1.0, 1.0, 0.0, None, None, None, ops, ws, jac)
 
 
 @kernel
@@ -25,7 +24,8 @@ def mobility_jacobian(w, isotropic, along, nonlocal_share, weight, direction, po
         m[f] = isotropic f + along (t·f) t + nonlocal_share K[f]     (t = x'),
 
     K the rule of ``nonlocal_maps`` on the grid, its weight W, direction e and the grid
-    positions (3, M) given (nonlocal_share = 0: the local mobility, no K).
+    positions (3, M) given; all three None for the local mobility (no K: Numba prunes the
+    K branches at compile time, so the local model's Jacobian compiles none of them).
     ws holds the column blocks at x (``loop_velocity_blocks`` or
     ``nonlocal_maps.nonlocal_loop_velocity``: force, mobile, dmobile, tension).
 
@@ -94,7 +94,7 @@ def mobility_jacobian(w, isotropic, along, nonlocal_share, weight, direction, po
                 for cc in range(3):
                     dm[i, cc, col] = s_ck * t[cc, i]
                 dm[i, c, col] += isotropic * big_f[i, j] + along * tf[i] * S1[i, j]
-    if nonlocal_share != 0.0:
+    if weight is not None:
         add_kernel_columns(nonlocal_share, weight, direction, big_f, dm)
         add_kernel_shape_columns(nonlocal_share, weight, direction, position, t, f, S0, S1, dm)
     pdm = np.dot(P1, dm.reshape((m, 3 * d))).reshape((m, 3, d))
@@ -120,7 +120,7 @@ def mobility_jacobian(w, isotropic, along, nonlocal_share, weight, direction, po
     for i in range(m):
         for c in range(3):
             pre[i, c] = isotropic * rho[i, c] + along * rt[i] * t[c, i]
-    if nonlocal_share != 0.0:
+    if weight is not None:
         add_adjoint_kernel(nonlocal_share, weight, direction, rho, pre)
     sig = np.dot(P.T, pre)  # (M, 3)
     rhs_t = np.dot(a.T, deps)  # (K, D): Aᵀ δε
@@ -136,7 +136,7 @@ def mobility_jacobian(w, isotropic, along, nonlocal_share, weight, direction, po
         for kk in range(k):
             for j in range(k):
                 rhs_t[j, c * k + kk] += block[kk, j]
-    if nonlocal_share != 0.0:
+    if weight is not None:
         add_kernel_shape_adjoint(nonlocal_share, weight, direction, position, t, rho, ws.force,
                                  S0, S1, rhs_t)
     dtau = -np.linalg.solve(np.dot(a.T, a), rhs_t)  # (K, D)
