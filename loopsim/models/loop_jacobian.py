@@ -95,8 +95,9 @@ def mobility_jacobian(w, isotropic, along, nonlocal_share, weight, direction, po
                     dm[i, cc, col] = s_ck * t[cc, i]
                 dm[i, c, col] += isotropic * big_f[i, j] + along * tf[i] * S1[i, j]
     if weight is not None:
+        inverse = inverse_distances(position)
         add_kernel_columns(nonlocal_share, weight, direction, big_f, dm)
-        add_kernel_shape_columns(nonlocal_share, weight, direction, position, t, f, S0, S1, dm)
+        add_kernel_shape_columns(nonlocal_share, weight, direction, inverse, t, f, S0, S1, dm)
     pdm = np.dot(P1, dm.reshape((m, 3 * d))).reshape((m, 3, d))
     # δε (M, D)
     deps = np.empty((m, d))
@@ -137,7 +138,7 @@ def mobility_jacobian(w, isotropic, along, nonlocal_share, weight, direction, po
             for j in range(k):
                 rhs_t[j, c * k + kk] += block[kk, j]
     if weight is not None:
-        add_kernel_shape_adjoint(nonlocal_share, weight, direction, position, t, rho, ws.force,
+        add_kernel_shape_adjoint(nonlocal_share, weight, direction, inverse, t, rho, ws.force,
                                  S0, S1, rhs_t)
     dtau = -np.linalg.solve(np.dot(a.T, a), rhs_t)  # (K, D)
     # δu = F (δm + m_T δT), then arrange as J[(c', k'), (c, k)]
@@ -219,15 +220,15 @@ def kernel_shape_term(weight, direction, c, l, i, g, out):
 
 
 @kernel
-def add_kernel_shape_columns(share, weight, direction, position, tangent, f, S0, S1, dm):
+def add_kernel_shape_columns(share, weight, direction, inverse, tangent, f, S0, S1, dm):
     """dm[l, a, c K + k] += share δK[f]_l,a for δx = e_c φ_k, the kernel's own change with
     the shape acting on the force f (3, M) at the solved tension:
 
         δK[f]_l = Σ_{i≠l} (φ_k(s_l) − φ_k(s_i)) H^c_li f_i / |R_li| + φ_k'(s_l) H^c_ll f_l / |x'_l|
 
-    (:func:`kernel_shape_term`; δR_li = e_c (φ_k(s_l) − φ_k(s_i)), δx'_l = e_c φ_k'(s_l))."""
+    (:func:`kernel_shape_term`; δR_li = e_c (φ_k(s_l) − φ_k(s_i)), δx'_l = e_c φ_k'(s_l);
+    inverse: :func:`inverse_distances` of the grid positions)."""
     m, k = S0.shape
-    inverse = inverse_distances(position)
     change = np.empty((3 * m, k))
     for c in range(3):
         shape_change(weight, direction, inverse, tangent, c, f, False, S0, S1, change)
@@ -238,7 +239,7 @@ def add_kernel_shape_columns(share, weight, direction, position, tangent, f, S0,
 
 
 @kernel
-def add_kernel_shape_adjoint(share, weight, direction, position, tangent, rho, force, S0, S1,
+def add_kernel_shape_adjoint(share, weight, direction, inverse, tangent, rho, force, S0, S1,
                              rhs_t):
     """rhs_t[j, c K + k] += share Σ_l rho_l · δK[f_j]_l, the tension columns' part of δAᵀ r
     from the kernel's change with the shape (f_j = force[:, :, j], j < K; δK as in
@@ -246,7 +247,6 @@ def add_kernel_shape_adjoint(share, weight, direction, position, tangent, rho, f
     Σ_i z_i · f_j,i,  z_i = Σ_{l≠i} (φ_k(s_l) − φ_k(s_i)) H^c_li rho_l / |R_li|
     + φ_k'(s_i) H^c_ii rho_i / |x'_i|."""
     m, k = S0.shape
-    inverse = inverse_distances(position)
     field = rho.T.copy()
     z = np.empty((3 * m, k))
     columns = np.empty((3 * m, k))
