@@ -316,11 +316,47 @@ def tilt_distribution(cells, frame=None, ax=None):
     return fig
 
 
-def distribution_summary(cells, frame):
-    """Two panels from a summary table (``summary.summarize``) and its rows: P(3D) per
-    cell (:func:`probability_phase_diagram`) and the terminal tilt over the seeds
-    (:func:`tilt_distribution`)."""
-    fig, axes = plt.subplots(1, 2, figsize=(13.5, 4.2), constrained_layout=True)
+def aspect_distribution(cells, frame=None, branch=None, ax=None):
+    """Terminal aspect ratio against terminal q as distributions (the distributional form
+    of the paper's Fig. 8): per cell the median aspect ratio with its 95 % bootstrap
+    interval (bars) and quartiles (thin bars) at the median terminal q with its quartiles
+    (horizontal bars), every seed faint behind (``frame``), over the steady branch
+    (``branch``: a DataFrame as ``stability.branch.steady_branch`` returns, or None)."""
+    from .figures.terminal import branch_lines
+
+    fig, ax = _axes(ax, (6.0, 4.0))
+    ax.axhline(1.0, color="0.85", lw=0.8, zorder=0)
+    if frame is not None:
+        ax.scatter(frame["q_final"], frame["aspect_ratio"], s=6, color="0.75", zorder=1,
+                   label="each seed")
+    if branch is not None and len(branch):
+        branch_lines(ax, branch)
+    q, ratio = cells["q_final_median"], cells["aspect_median"]
+    ax.errorbar(q, ratio, xerr=[q - cells["q_final_q25"], cells["q_final_q75"] - q],
+                yerr=[ratio - cells["aspect_q25"], cells["aspect_q75"] - ratio],
+                fmt="none", ecolor="0.45", elinewidth=0.8, capsize=2, zorder=3,
+                label="quartiles")
+    ax.errorbar(q, ratio, yerr=[ratio - cells["aspect_median_low"],
+                                cells["aspect_median_high"] - ratio],
+                fmt="o", ms=3.5, color="#3b0f70", elinewidth=1.6, zorder=4,
+                label="median, 95% interval")
+    ax.set_xlabel(r"terminal $q = g_0 \sin\theta / 3$")
+    ax.set_ylabel("terminal aspect ratio")
+    ax.set_title("terminal shape over seeds", fontsize=10)
+    ax.set_xlim(left=0)
+    ax.legend(fontsize=7, framealpha=0.9, loc="best")
+    return fig
+
+
+def distribution_summary(cells, frame, branch=None):
+    """The panels of a summary table (``summary.summarize``) and its rows: P(3D) per
+    cell (:func:`probability_phase_diagram`), the terminal tilt over the seeds
+    (:func:`tilt_distribution`) and, when the table has terminal q, the aspect ratio
+    over the steady branch ``branch`` (:func:`aspect_distribution`)."""
+    panels = 3 if "q_final_median" in cells else 2
+    fig, axes = plt.subplots(1, panels, figsize=(6.6 * panels, 4.4), constrained_layout=True)
     probability_phase_diagram(cells, ax=axes[0])
     tilt_distribution(cells, frame, ax=axes[1])
+    if panels == 3:
+        aspect_distribution(cells, frame, branch=branch, ax=axes[2])
     return fig

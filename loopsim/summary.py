@@ -11,9 +11,10 @@ was swept: ``n``, ``rtol``, ``perturbation`` ...).  Per cell:
 
       (p̂ + z²/2N ± z sqrt(p̂(1 − p̂)/N + z²/4N²)) / (1 + z²/N),  z = Φ⁻¹(0.975)
 
-* the median and quartiles of the terminal tilt and aspect ratio, each median with a
-  95 % percentile-bootstrap interval (``BOOTSTRAP_RESAMPLES`` resamples from a
-  generator seeded with ``seed``, so the table is reproducible bit for bit);
+* the median and quartiles of the terminal tilt, aspect ratio and q (``tilt_*``,
+  ``aspect_*``, ``q_final_*``), each median with a 95 % percentile-bootstrap interval
+  (``BOOTSTRAP_RESAMPLES`` resamples from a generator seeded with ``seed``, so the
+  table is reproducible bit for bit);
 * the cost: ``nfev`` and ``twin_nfev`` summed, ``wall_s`` summed.
 
 Plain NumPy and pandas: no integration happens here.
@@ -27,6 +28,9 @@ from .outcomes import REGIMES
 Z95 = 1.959963984540054
 BOOTSTRAP_RESAMPLES = 2000
 #: The inputs that may define a cell (the seed never does).
+#: The outcome columns summarised by quantiles, and their prefixes in the summary.
+OUTCOME_STATISTICS = (("theta_final_deg", "tilt"), ("aspect_ratio", "aspect"),
+                      ("q_final", "q_final"))
 CELL_INPUTS = ("g0", "theta0_deg", "n", "t_end", "rtol", "atol", "w", "perturbation",
                "method")
 
@@ -73,7 +77,9 @@ def _cell_row(rows, seed):
         hits = int((rows["regime"] == regime).sum())
         out[f"p_{name}"] = hits / trials
         out[f"p_{name}_low"], out[f"p_{name}_high"] = wilson_interval(hits, trials)
-    for column, short in (("theta_final_deg", "tilt"), ("aspect_ratio", "aspect")):
+    for column, short in OUTCOME_STATISTICS:
+        if column not in rows:
+            continue
         values = rows[column].to_numpy(float)
         finite = values[np.isfinite(values)]
         quartiles = np.percentile(finite, [25, 50, 75]) if finite.size else [np.nan] * 3

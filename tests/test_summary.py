@@ -132,7 +132,8 @@ def test_summary_figures_draw_every_cell():
                                  resolved=True, determined=not (g0 > 100 and seed == 2),
                                  q0=g0 * np.sin(np.radians(theta)) / 3,
                                  theta_final_deg=theta - (10 + seed if g0 > 100 else 0),
-                                 aspect_ratio=1.5, nfev=1, twin_nfev=1, wall_s=0.1))
+                                 aspect_ratio=1.5 + 0.1 * seed, nfev=1, twin_nfev=1,
+                                 wall_s=0.1, q_final=g0 / 10 + seed))
     frame = pd.DataFrame(rows)
     cells = summary.summarize(frame)
     fig = plots.probability_phase_diagram(cells)
@@ -144,3 +145,20 @@ def test_summary_figures_draw_every_cell():
     assert sorted(t.get_text() for t in fig.axes[0].texts) == ["0.25", "0.25"]
     fig = plots.tilt_distribution(cells, frame)
     assert len(fig.axes[0].collections[0].get_offsets()) == len(frame)  # every seed, faint
+    # Fig. 8 as distributions: one median per cell at its median terminal q, every seed
+    # faint, over the steady branch drawn solid where stable, dashed where not
+    assert list(cells["q_final_median"]) == [4.5, 4.5, 16.5, 16.5]
+    np.testing.assert_allclose(cells["aspect_median"], 1.65)
+    branch = pd.DataFrame(dict(q=[0.0, 5.0, 10.0], aspect_ratio=[1.0, 1.5, 2.0],
+                               stable_in_plane=[True, True, False],
+                               stable_out_of_plane=[True, True, True]))
+    fig = plots.aspect_distribution(cells, frame, branch=branch)
+    ax = fig.axes[0]
+    assert len(ax.collections[0].get_offsets()) == len(frame)
+    medians = [line for line in ax.lines if line.get_marker() == "o"]
+    assert len(medians) == 1 and list(medians[0].get_xdata()) == list(cells["q_final_median"])
+    assert {line.get_linestyle() for line in ax.lines if line.get_label().startswith(
+        "steady shapes")} == {"-", "--"}
+    fig = plots.distribution_summary(cells, frame, branch=branch)
+    assert [a.get_title() for a in fig.axes[:3]][1:] == ["terminal tilt over seeds",
+                                                        "terminal shape over seeds"]

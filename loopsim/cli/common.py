@@ -157,3 +157,25 @@ def use_agg():
     import matplotlib
 
     matplotlib.use("Agg")
+
+
+#: Where the steady branch drawn under a distribution summary ends, at most (its cost
+#: grows with it: about 25 s to q = 25 at n = 12 on one core).
+BRANCH_Q_MAX = 25.0
+
+
+def save_distribution_figure(table, frame, path):
+    """Draw a summary table and its rows (``plots.distribution_summary``) to ``path``:
+    for the local model over its steady branch (n = 12) up to the largest terminal q
+    seen (at most :data:`BRANCH_Q_MAX`), which the branch's solver is asked for here."""
+    from .. import plots
+
+    use_agg()
+    branch = None
+    q_final = frame["q_final"].to_numpy(float) if "q_final" in frame else []
+    if plots.frame_model(frame).name == "local" and len(q_final):
+        from ..figures.linear import load_branch
+
+        q_max = min(BRANCH_Q_MAX, 1.05 * max(float(q) for q in q_final if q == q))
+        branch, _ = load_branch(12, q_max=max(q_max, 1.0))
+    plots.save(plots.distribution_summary(table, frame, branch=branch), path, dpi=150)

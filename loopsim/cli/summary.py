@@ -2,7 +2,7 @@
 intervals), printed and optionally written and drawn."""
 import os
 
-from .common import HelpFormatter, print_and_write, use_agg
+from .common import HelpFormatter, print_and_write, save_distribution_figure
 
 
 def add_parser(commands):
@@ -21,7 +21,8 @@ def add_parser(commands):
     summary.add_argument("--out", metavar="FILE.parquet", help="also write the table to Parquet")
     summary.add_argument("--seed", type=int, default=0, help="seed of the bootstrap (>= 0)")
     summary.add_argument("--figure", metavar="PNG",
-                         help="also draw P(3D) per cell and the terminal tilt over seeds")
+                         help="also draw P(3D) per cell, the terminal tilt over seeds and the "
+                         "aspect ratio over the steady branch")
     return summary
 
 
@@ -40,9 +41,6 @@ def command(args):
     print_and_write(table, args.out, dict(table.attrs["loopsim_summary"],
                                            summary_of=os.path.abspath(args.sweep_dir)), shown)
     if args.figure is not None:
-        use_agg()
-        from .. import plots
-
-        plots.save(plots.distribution_summary(table, frame), args.figure, dpi=150)
+        save_distribution_figure(table, frame, args.figure)
         print(f"figure: {args.figure}")
     return 0

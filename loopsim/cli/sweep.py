@@ -6,7 +6,7 @@ import sys
 from ..config import DEFAULT_AUTO_CHUNK_SIZE, DEFAULT_CHUNK_SIZE, DEFAULT_N, SEED_TARGETS
 from .common import (
     EXIT_FAILED_RUN, HelpFormatter, Parser, add_integration_options, check_auto_options,
-    interrupted, real, use_agg,
+    interrupted, real, save_distribution_figure, use_agg,
 )
 
 
@@ -298,8 +298,7 @@ def command(args):
         if seeds_auto:
             from .. import summary
 
-            plots.save(plots.distribution_summary(summary.summarize(frame), frame),
-                       args.figure, dpi=150)
+            save_distribution_figure(summary.summarize(frame), frame, args.figure)
         else:
             plots.save(plots.phase_diagram(frame), args.figure)
         print(f"{'distribution summary' if seeds_auto else 'phase diagram'}: {args.figure}")

@@ -43,7 +43,7 @@ def q_and_tilt(frame, thresholds=None, axes=None, reference=None):
     return fig
 
 
-def _branch_lines(ax, branch):
+def branch_lines(ax, branch):
     """The steady branch: solid where stable in and out of plane, dashed elsewhere."""
     stable = (branch["stable_in_plane"].to_numpy(bool)
               & branch["stable_out_of_plane"].to_numpy(bool))
@@ -75,7 +75,7 @@ def aspect_ratio(frame, branch=None, ax=None, reference=None, q_max=None):
     scatter_regimes(ax, frame, "q_final", "aspect_ratio")
     _reference(ax, reference, "q_final", "aspect_ratio")
     if branch is not None and len(branch):
-        _branch_lines(ax, branch)
+        branch_lines(ax, branch)
     ax.set_xlabel(r"terminal $q = g_0 \sin\theta / 3$")
     ax.set_ylabel("terminal " + ASPECT_LABEL)
     ax.set_title(f"terminal shape against terminal q, {orders_text(frame)}", fontsize=10)
