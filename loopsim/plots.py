@@ -252,27 +252,67 @@ def trajectory(frame, n, title="", axes=None):
     return ax_shape.figure
 
 
-def probability_phase_diagram(cells, frame=None, ax=None):
+def _wedge_marker(start, stop, points=24):
+    """A pie wedge from angle ``start`` to ``stop`` (radians, counter-clockwise) as a
+    scatter marker, and the factor its size must be scaled by: matplotlib rescales a
+    marker's vertices to its largest coordinate, so a narrow wedge would grow."""
+    angles = np.linspace(start, stop, max(2, int(points * (stop - start) / np.pi) + 2))
+    verts = np.vstack([[0.0, 0.0], np.column_stack([np.cos(angles), np.sin(angles)]),
+                       [0.0, 0.0]])
+    return verts, float(np.abs(verts).max()) ** 2
+
+
+def regime_pies(cells, ax, size=150):
+    """Each cell of a summary table at (θ0, g0) as a pie of its regime probabilities
+    (``p_stable``, ``p_in_plane``, ``p_3d``, ``p_failed``), clockwise from the top, in
+    the regime colours of :data:`REGIME_STYLE`."""
+    reached = set()
+    for _, cell in cells.iterrows():
+        start = np.pi / 2
+        for regime, style in REGIME_STYLE.items():
+            share = float(cell.get(f"p_{regime.replace('-', '_')}", 0.0) or 0.0)
+            if share <= 0.0:
+                continue
+            stop = start - 2 * np.pi * share
+            verts, scale = _wedge_marker(stop, start)
+            ax.scatter([cell["theta0_deg"]], [cell["g0"]], marker=verts, s=size * scale,
+                       color=style["color"], edgecolors="none", zorder=3)
+            reached.add(regime)
+            start = stop
+    for regime in (r for r in REGIME_STYLE if r in reached):  # legend entries: whole discs
+        ax.scatter([], [], marker="o", s=size / 2, color=REGIME_STYLE[regime]["color"],
+                   label=REGIME_STYLE[regime]["label"])
+
+
+def probability_phase_diagram(cells, frame=None, ax=None, style="pie"):
     """The phase diagram read as probabilities: each cell of a summary table
-    (``loopsim.summarize``) at (θ0, g0), coloured by its probability of ending 3D, ringed
-    red where any seed is not determined, labelled with P(in-plane) when it is neither 0
-    nor 1; with the full linearisation's thresholds (``q_c`` at n = 16)."""
+    (``loopsim.summarize``) at (θ0, g0) as a pie of its regime probabilities
+    (``style="pie"``, :func:`regime_pies`) or coloured by its probability of ending 3D
+    (``style="colour"``, labelled with P(in-plane) when it is neither 0 nor 1); ringed
+    red where any seed is not determined; with the full linearisation's thresholds
+    (``q_c`` at n = 16)."""
+    if style not in ("pie", "colour"):
+        raise ValueError(f"style must be 'pie' or 'colour', got {style!r}")
     fig, ax = _axes(ax, (6.8, 4.0))
-    points = ax.scatter(cells["theta0_deg"], cells["g0"], c=cells["p_3d"], cmap="viridis",
-                        vmin=0.0, vmax=1.0, s=60, edgecolors="k", linewidths=0.4, zorder=3)
-    fig.colorbar(points, ax=ax, label="P(3D) over seeds")
+    if style == "pie":
+        regime_pies(cells, ax)
+    else:
+        points = ax.scatter(cells["theta0_deg"], cells["g0"], c=cells["p_3d"],
+                            cmap="viridis", vmin=0.0, vmax=1.0, s=60, edgecolors="k",
+                            linewidths=0.4, zorder=3)
+        fig.colorbar(points, ax=ax, label="P(3D) over seeds")
+        for _, cell in cells[(cells["p_in_plane"] > 0) & (cells["p_in_plane"] < 1)].iterrows():
+            ax.annotate(f"{cell['p_in_plane']:.2f}", (cell["theta0_deg"], cell["g0"]),
+                        textcoords="offset points", xytext=(0, 7), ha="center", fontsize=6)
     mixed = cells[cells["determined"] < cells["seeds"]]
     if len(mixed):
-        ax.scatter(mixed["theta0_deg"], mixed["g0"], s=150, facecolors="none",
-                   edgecolors="#d62728", linewidths=0.9, zorder=4,
+        ax.scatter(mixed["theta0_deg"], mixed["g0"], s=230 if style == "pie" else 150,
+                   facecolors="none", edgecolors="#d62728", linewidths=0.9, zorder=4,
                    label="some seeds not determined")
-    for _, cell in cells[(cells["p_in_plane"] > 0) & (cells["p_in_plane"] < 1)].iterrows():
-        ax.annotate(f"{cell['p_in_plane']:.2f}", (cell["theta0_deg"], cell["g0"]),
-                    textcoords="offset points", xytext=(0, 7), ha="center", fontsize=6)
     theta = np.linspace(1.0, 90.0, 300)
-    for sector, style in (("in-plane", "--"), ("out-of-plane", ":")):
+    for sector, line in (("in-plane", "--"), ("out-of-plane", ":")):
         q_sector = circle.critical_q(16, sector)
-        ax.plot(theta, 3 * q_sector / np.sin(np.radians(theta)), "k", ls=style, lw=1.0,
+        ax.plot(theta, 3 * q_sector / np.sin(np.radians(theta)), "k", ls=line, lw=1.0,
                 label=f"{sector} threshold, q = {q_sector:.3f}")
     ax.set_xlim(0, 92)
     ax.set_ylim(0, 1.08 * cells["g0"].max())
@@ -280,7 +320,8 @@ def probability_phase_diagram(cells, frame=None, ax=None):
     ax.set_ylabel(r"$g_0$ (gravity / stiffness)")
     seeds = sorted(set(int(k) for k in cells["seeds"]))
     count = str(seeds[0]) if len(seeds) == 1 else f"{seeds[0]}-{seeds[-1]}"
-    ax.set_title(f"P(3D) per cell over {count} seeds (numbers: P(in-plane))", fontsize=10)
+    ax.set_title(f"regime probabilities per cell over {count} seeds" if style == "pie" else
+                 f"P(3D) per cell over {count} seeds (numbers: P(in-plane))", fontsize=10)
     ax.legend(fontsize=7, frameon=False, loc="upper center", bbox_to_anchor=(0.5, -0.14),
               ncol=3)
     return fig

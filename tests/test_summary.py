@@ -136,13 +136,28 @@ def test_summary_figures_draw_every_cell():
                                  wall_s=0.1, q_final=g0 / 10 + seed))
     frame = pd.DataFrame(rows)
     cells = summary.summarize(frame)
-    fig = plots.probability_phase_diagram(cells)
+    fig = plots.probability_phase_diagram(cells, style="colour")
     colours = fig.axes[0].collections[0]
     assert len(colours.get_offsets()) == 4
     np.testing.assert_allclose(colours.get_array(), cells["p_3d"])
     rings = [c for c in fig.axes[0].collections if c.get_label() == "some seeds not determined"]
     assert len(rings) == 1 and len(rings[0].get_offsets()) == 2
     assert sorted(t.get_text() for t in fig.axes[0].texts) == ["0.25", "0.25"]
+    # as pies: one wedge per regime a cell reaches, clockwise from the top, filling it
+    fig = plots.probability_phase_diagram(cells)
+    wedges = [c for c in fig.axes[0].collections if c.get_label() != "some seeds not determined"
+              and len(c.get_offsets()) == 1]
+    assert len(wedges) == 1 + 1 + 2 + 2
+    assert sorted(c.get_label() for c in fig.axes[0].collections
+                  if not len(c.get_offsets())) == ["3D", "in-plane", "stable"]  # the legend
+    verts, scale = plots._wedge_marker(0.0, np.pi / 2)
+    assert scale == pytest.approx(1.0) and np.allclose(verts[1], [1, 0]) and np.allclose(
+        verts[-2], [0, 1])
+    _, scale = plots._wedge_marker(np.pi / 4 - 0.1, np.pi / 4 + 0.1)
+    assert scale == pytest.approx(np.cos(np.pi / 4 - 0.1) ** 2)  # the marker's rescaling undone
+    assert fig.axes[0].get_title() == "regime probabilities per cell over 4 seeds"
+    with pytest.raises(ValueError, match="style must be"):
+        plots.probability_phase_diagram(cells, style="bars")
     fig = plots.tilt_distribution(cells, frame)
     assert len(fig.axes[0].collections[0].get_offsets()) == len(frame)  # every seed, faint
     # Fig. 8 as distributions: one median per cell at its median terminal q, every seed
