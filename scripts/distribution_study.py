@@ -5,16 +5,17 @@ Usage: python scripts/distribution_study.py [--runs runs/distributions] [--threa
                                             [--max-seeds 32]
                                             [--check tolerance|resolution]
                                             [--check-seeds 16] [--check-n 32]
-                                            [--check-theta0 SPEC]
+                                            [--check-g0 SPEC] [--check-theta0 SPEC]
 
 1. ``--seeds auto`` at ``--n auto`` (with twins) over the grid (``--g0`` and ``--theta0``
    as ``loopsim sweep`` takes them: ``10:150:8`` or ``30,60``): every point gets seeds
    until it is deterministic, sharp or at --max-seeds (``RUNS/auto``);
-2. the points that did not stop as deterministic (those at --check-theta0 only, when
-   given) again, with --check-seeds fixed seeds and no twins (``RUNS/<check>``), either at
+2. the points that did not stop as deterministic (those at --check-g0 and --check-theta0
+   only, when given) again, with --check-seeds fixed seeds and no twins (``RUNS/<check>``), either at
    10x stricter rtol and atol (``--check tolerance``) or at the fixed order --check-n
-   (``--check resolution``), compared in distribution with the first sweep's seeds
-   0 .. --check-seeds - 1 (``loopsim.compare``);
+   (``--check resolution``), compared in distribution (``loopsim.compare``) with the
+   first sweep's seeds 0 .. --check-seeds - 1 (the same starts) or, for the resolution
+   check, all its seeds (the start at --check-n differs in its higher modes);
 3. writes the summary (``RUNS/summary.parquet``) and the comparison
    (``RUNS/compare-<check>.parquet``), prints them and the stop table as Markdown, and
    draws ``RUNS/summary.png`` (P(3D) per point, tilt and aspect ratio over seeds).
@@ -41,11 +42,13 @@ def markdown(frame, columns, formats):
     return head + "\n".join(rows)
 
 
-def check_cells(stops, theta0):
-    """The cells to check: not deterministic, and at one of ``theta0`` when given."""
+def check_cells(stops, g0, theta0):
+    """The cells to check: not deterministic, and at one of ``g0`` and ``theta0`` when
+    given (None: any)."""
     cells = stops[stops["stop_reason"] != "deterministic"]
-    if theta0 is not None:
-        cells = cells[cells["theta0_deg"].isin(theta0)]
+    for column, values in (("g0", g0), ("theta0_deg", theta0)):
+        if values is not None:
+            cells = cells[cells[column].isin(values)]
     return [dict(g0=r.g0, theta0_deg=r.theta0_deg) for r in cells.itertuples()]
 
 
@@ -74,12 +77,14 @@ def main():
     parser.add_argument("--check", choices=sorted(CHECKS), default="tolerance")
     parser.add_argument("--check-seeds", type=int, default=16)
     parser.add_argument("--check-n", type=int, default=32)
+    parser.add_argument("--check-g0", default=None)
     parser.add_argument("--check-theta0", default=None)
     args = parser.parse_args()
     g0 = sweeps.parse_values(args.g0, "--g0")
     theta0 = sweeps.parse_values(args.theta0, "--theta0")
-    check_theta0 = (None if args.check_theta0 is None
-                    else sweeps.parse_values(args.check_theta0, "--check-theta0"))
+    check_g0, check_theta0 = (
+        None if text is None else sweeps.parse_values(text, name)
+        for text, name in ((args.check_g0, "--check-g0"), (args.check_theta0, "--check-theta0")))
 
     started = time.perf_counter()
     auto_dir = os.path.join(args.runs, "auto")
@@ -91,10 +96,12 @@ def main():
 
     started = time.perf_counter()
     comparison = None
-    checked = check_cells(stops, check_theta0)
+    checked = check_cells(stops, check_g0, check_theta0)
     if checked:
         again = run_check(checked, args)
-        first = rows[rows["seed"] < args.check_seeds]
+        # the tolerance check repeats the same starts (seeds 0 .. K-1); at another order
+        # the start differs in its modes above 16, so every seed of the first sweep counts
+        first = rows[rows["seed"] < args.check_seeds] if args.check == "tolerance" else rows
         comparison = loopsim.compare(first, again, by=["g0", "theta0_deg"])
     check_s = time.perf_counter() - started
 
