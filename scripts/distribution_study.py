@@ -13,9 +13,9 @@ Usage: python scripts/distribution_study.py [--runs runs/distributions] [--threa
 2. the points that did not stop as deterministic (those at --check-g0 and --check-theta0
    only, when given) again, with --check-seeds fixed seeds and no twins (``RUNS/<check>``), either at
    10x stricter rtol and atol (``--check tolerance``) or at the fixed order --check-n
-   (``--check resolution``), compared in distribution (``loopsim.compare``) with the
-   first sweep's seeds 0 .. --check-seeds - 1 (the same starts) or, for the resolution
-   check, all its seeds (the start at --check-n differs in its higher modes);
+   from the same starts as ``--n auto`` (``--check resolution``, run on --threads
+   processes), compared in distribution (``loopsim.compare``) and row by row with the
+   first sweep's seeds 0 .. --check-seeds - 1;
 3. writes the summary (``RUNS/summary.parquet``) and the comparison
    (``RUNS/compare-<check>.parquet``), prints them and the stop table as Markdown, and
    draws ``RUNS/summary.png`` (P(3D) per point, tilt and aspect ratio over seeds).
@@ -23,13 +23,16 @@ Usage: python scripts/distribution_study.py [--runs runs/distributions] [--threa
 Every step resumes: re-run the same command after an interruption.
 """
 import argparse
+import concurrent.futures
+import math
+import multiprocessing
 import os
 import time
 
 import pandas as pd
 
 import loopsim
-from loopsim import io, sweeps
+from loopsim import config, io, refinement, shapes, spectral, sweeps
 from loopsim.cli.common import print_and_write, save_distribution_figure
 
 CHECKS = {"tolerance": dict(rtol=1e-7, atol=1e-10), "resolution": {}}
@@ -52,18 +55,58 @@ def check_cells(stops, g0, theta0):
     return [dict(g0=r.g0, theta0_deg=r.theta0_deg) for r in cells.itertuples()]
 
 
+def same_start_run(g0, theta0_deg, seed, n):
+    """One run at the fixed order ``n`` from the start ``--n auto`` uses (the circle with
+    its seeded perturbation at the ladder's first order, zero-padded exactly to ``n``),
+    with the sweep's defaults and early stop, no twin: its summary row."""
+    start = shapes.initial_shape(refinement.AUTO_START, math.radians(theta0_deg),
+                                 config.DEFAULT_PERTURBATION, seed)
+    result = loopsim.simulate(g0, None, initial=spectral.resize(start, n), method="auto",
+                              twin=False, steady_tol=config.DEFAULT_STEADY_TOL,
+                              steady_interval=config.DEFAULT_STEADY_INTERVAL)
+    # the cell's inputs as given (the measured tilt differs from them by the perturbation)
+    return dict(result.summary(), g0=g0, theta0_deg=theta0_deg, seed=seed, n=n)
+
+
+def resolution_check(cells, args, directory):
+    """Seeds 0 .. --check-seeds - 1 of each cell at the fixed order --check-n from the
+    same starts as ``--n auto``, on --threads processes; one Parquet file per cell in
+    ``directory`` (written whole, so a rerun skips the cells done)."""
+    os.makedirs(directory, exist_ok=True)
+    frames, todo = [], []
+    for cell in cells:
+        path = os.path.join(directory, f"g{cell['g0']:g}_t{cell['theta0_deg']:g}.parquet")
+        if os.path.exists(path):
+            frames.append(pd.read_parquet(path))
+        else:
+            todo.append((cell, path))
+    context = multiprocessing.get_context("spawn")  # no fork of a process that ran prange
+    with concurrent.futures.ProcessPoolExecutor(args.threads or os.cpu_count(),
+                                                mp_context=context) as pool:
+        for cell, path in todo:
+            rows = list(pool.map(same_start_run, *zip(*[
+                (cell["g0"], cell["theta0_deg"], seed, args.check_n)
+                for seed in range(args.check_seeds)])))
+            frame = pd.DataFrame(rows)
+            frame.to_parquet(path + ".part", index=False)
+            os.replace(path + ".part", path)
+            print(f"{args.check} check: g0 = {cell['g0']:g}, theta0 = {cell['theta0_deg']:g}: "
+                  f"{frame['wall_s'].sum():.0f} s summed", flush=True)
+            frames.append(frame)
+    return pd.concat(frames, ignore_index=True)
+
+
 def run_check(cells, args):
-    """Each cell again with --check-seeds seeds and no twins, as --check says."""
-    options = dict(CHECKS[args.check], twin=False, threads=args.threads, quiet=False)
-    if args.check == "resolution":
-        options.update(n=args.check_n, method="auto")
-    else:
-        options.update(n="auto")
+    """Each cell again with --check-seeds seeds and no twins, as --check says: at 10x
+    stricter tolerances (a ``--n auto`` sweep) or at the fixed order --check-n."""
     directory = os.path.join(args.runs, args.check)
+    if args.check == "resolution":
+        return resolution_check(cells, args, directory)
+    options = dict(CHECKS[args.check], twin=False, threads=args.threads, quiet=False)
     return pd.concat([
         loopsim.sweep([c["g0"]], [c["theta0_deg"]],
                       os.path.join(directory, f"g{c['g0']:g}_t{c['theta0_deg']:g}"),
-                      seeds=args.check_seeds, **options)
+                      n="auto", seeds=args.check_seeds, **options)
         for c in cells], ignore_index=True)
 
 
@@ -99,10 +142,14 @@ def main():
     checked = check_cells(stops, check_g0, check_theta0)
     if checked:
         again = run_check(checked, args)
-        # the tolerance check repeats the same starts (seeds 0 .. K-1); at another order
-        # the start differs in its modes above 16, so every seed of the first sweep counts
-        first = rows[rows["seed"] < args.check_seeds] if args.check == "tolerance" else rows
+        # both checks repeat the same starts, seeds 0 .. K-1
+        first = rows[rows["seed"] < args.check_seeds]
         comparison = loopsim.compare(first, again, by=["g0", "theta0_deg"])
+        paired = first.merge(again, on=["g0", "theta0_deg", "seed"], suffixes=("", "_check"))
+        shift = (paired["theta_final_deg"] - paired["theta_final_deg_check"]).abs()
+        print(f"row by row ({len(paired)} pairs): |tilt - tilt_check| median "
+              f"{shift.median():.3g} deg, largest {shift.max():.3g} deg; same regime in "
+              f"{int((paired['regime'] == paired['regime_check']).sum())}")
     check_s = time.perf_counter() - started
 
     save_distribution_figure(cells, rows, os.path.join(args.runs, "summary.png"))
