@@ -110,6 +110,26 @@ def run_check(cells, args):
         for c in cells], ignore_index=True)
 
 
+def single_run_reading(rows, cells):
+    """Per cell, what its seed-0 run (a one-run-per-cell sweep's row, the paper's
+    reading) says against the cell's distribution: its regime and that regime's
+    probability, and its terminal tilt's rank among the seeds (0: lowest, 1: highest)
+    and whether it lies inside the median's 95 % interval."""
+    out = []
+    for cell in cells.itertuples():
+        seeds = rows[(rows["g0"] == cell.g0) & (rows["theta0_deg"] == cell.theta0_deg)]
+        first = seeds[seeds["seed"] == 0].iloc[0]
+        tilt = first["theta_final_deg"]
+        out.append(dict(g0=cell.g0, theta0_deg=cell.theta0_deg, seeds=len(seeds),
+                        regime_0=first["regime"],
+                        p_regime_0=float((seeds["regime"] == first["regime"]).mean()),
+                        tilt_0=tilt, tilt_median=cell.tilt_median,
+                        tilt_rank_0=float((seeds["theta_final_deg"] < tilt).mean()),
+                        in_median_interval=bool(cell.tilt_median_low <= tilt
+                                                <= cell.tilt_median_high)))
+    return pd.DataFrame(out)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", default=os.path.join("runs", "distributions"))
@@ -169,6 +189,9 @@ def main():
                           | {c: "{:.2f}" for c in ["tilt_median", "tilt_q25", "tilt_q75",
                                                    "tilt_median_low", "tilt_median_high"]}
                           | {"aspect_median": "{:.3f}"}))
+    reading = single_run_reading(rows, cells)
+    print("\nthe seed-0 run (one run per cell) against its cell's seeds:")
+    print(reading.to_string(index=False, float_format=lambda v: f"{v:.3g}"))
     if comparison is not None:
         print_and_write(comparison, os.path.join(args.runs, f"compare-{args.check}.parquet"),
                         dict(compared=f"{args.check} check"), ["g0", "theta0_deg", "verdict"])
