@@ -38,6 +38,10 @@ The steps (the runs), with the figures that need them:
   ``--n auto`` with twins over g0 = 30, 60, 100 x θ0 = 30, 60°: seeds_auto_study
   (``loopsim summary --figure``; ``scripts/distribution_study.py`` runs the same sweep
   and its stricter-tolerance check);
+* ``seeds_auto_grid``: docs/distributions.md's grid study, the main job's 72 points at
+  ``--seeds auto`` (at most 16) with twins: seeds_auto_grid (``loopsim summary
+  --figure``; ``scripts/distribution_study.py`` runs the same sweep and its resolution
+  check);
 * ``seed_cells``: docs/distributions.md's four cells (g0 = 100, 150 x θ0 = 45, 60°),
   16 seeds each at ``--n auto`` with twins: seed_cells (``loopsim summary --figure``);
 * ``nonlocal_eps1e-2``, ``nonlocal_eps1e-3``: the main job's grid at ``--n auto`` under
@@ -161,6 +165,8 @@ def steps(runs, threads, quick=False, n24=False):
               "--n", "auto", *auto_quick, capped=True),
         sweep("seeds_auto_study", "--g0", "30,60,100", "--theta0", "30,60", "--seeds", "auto",
               "--max-seeds", "4" if quick else "32", "--n", "auto", *auto_quick, capped=True),
+        sweep("seeds_auto_grid", *main_job, "--seeds", "auto", "--max-seeds",
+              "4" if quick else "16", *auto_quick, capped=True),
         *(sweep(f"nonlocal_eps{eps}", *main_job, *auto_quick, "--model", "nonlocal",
                 "--slenderness", eps, *lean, capped=True) for eps in NONLOCAL_SLENDERNESS),
     ])
@@ -208,6 +214,7 @@ def targets(quick=False):
                               ("models", "main_job", *nonlocal_steps)),
         "seed_cells": (["seed_cells"], ("summary", "seed_cells")),
         "seeds_auto_study": (["seeds_auto_study"], ("summary", "seeds_auto_study")),
+        "seeds_auto_grid": (["seeds_auto_grid"], ("summary", "seeds_auto_grid")),
         "seed_distributions": (["seeds_n6", "seeds_auto"],
                                ("figures", "seeds_n6", ["seeds_n6", "seeds_auto"], "seeds",
                                 "seed_distributions")),
