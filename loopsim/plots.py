@@ -390,8 +390,8 @@ def aspect_distribution(cells, frame=None, branch=None, ax=None):
 
 
 def distribution_summary(cells, frame, branch=None):
-    """The panels of a summary table (``summary.summarize``) and its rows: P(3D) per
-    cell (:func:`probability_phase_diagram`), the terminal tilt over the seeds
+    """The panels of a summary table (``summary.summarize``) and its rows: the regime
+    probabilities per cell (:func:`probability_phase_diagram`), the terminal tilt over the seeds
     (:func:`tilt_distribution`) and, when the table has terminal q, the aspect ratio
     over the steady branch ``branch`` (:func:`aspect_distribution`)."""
     panels = 3 if "q_final_median" in cells else 2

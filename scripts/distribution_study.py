@@ -18,7 +18,7 @@ Usage: python scripts/distribution_study.py [--runs runs/distributions] [--threa
    first sweep's seeds 0 .. --check-seeds - 1;
 3. writes the summary (``RUNS/summary.parquet``) and the comparison
    (``RUNS/compare-<check>.parquet``), prints them and the stop table as Markdown, and
-   draws ``RUNS/summary.png`` (P(3D) per point, tilt and aspect ratio over seeds).
+   draws ``RUNS/summary.png`` (regime probabilities per point, tilt and aspect ratio over seeds).
 
 Every step resumes: re-run the same command after an interruption.
 """
