@@ -252,7 +252,7 @@ def trajectory(frame, n, title="", axes=None):
     return ax_shape.figure
 
 
-def _wedge_marker(start, stop, points=24):
+def wedge_marker(start, stop, points=24):
     """A pie wedge from angle ``start`` to ``stop`` (radians, counter-clockwise) as a
     scatter marker, and the factor its size must be scaled by: matplotlib rescales a
     marker's vertices to its largest coordinate, so a narrow wedge would grow."""
@@ -274,7 +274,7 @@ def regime_pies(cells, ax, size=150):
             if share <= 0.0:
                 continue
             stop = start - 2 * np.pi * share
-            verts, scale = _wedge_marker(stop, start)
+            verts, scale = wedge_marker(stop, start)
             ax.scatter([cell["theta0_deg"]], [cell["g0"]], marker=verts, s=size * scale,
                        color=style["color"], edgecolors="none", zorder=3)
             reached.add(regime)
@@ -357,14 +357,31 @@ def tilt_distribution(cells, frame=None, ax=None):
     return fig
 
 
+def branch_lines(ax, branch):
+    """The steady branch: solid where stable in and out of plane, dashed elsewhere."""
+    stable = (branch["stable_in_plane"].to_numpy(bool)
+              & branch["stable_out_of_plane"].to_numpy(bool))
+    q, ar = branch["q"].to_numpy(float), branch["aspect_ratio"].to_numpy(float)
+    order = branch.attrs.get("n")
+    for flag, style, label in ((True, "-", "steady shapes, stable"),
+                               (False, "--", "steady shapes, unstable")):
+        y = np.where(stable == flag, ar, np.nan)
+        # keep the segments joined where stability changes
+        joined = y.copy()
+        change = np.nonzero(stable[1:] != stable[:-1])[0]
+        joined[change + (0 if flag else 1)] = ar[change + (0 if flag else 1)]
+        joined[change + (1 if flag else 0)] = ar[change + (1 if flag else 0)]
+        if np.any(np.isfinite(joined)):
+            ax.plot(q, joined, color="k", ls=style, lw=1.3,
+                    label=label + (f" (n = {order})" if order else ""), zorder=2)
+
+
 def aspect_distribution(cells, frame=None, branch=None, ax=None):
     """Terminal aspect ratio against terminal q as distributions (the distributional form
     of the paper's Fig. 8): per cell the median aspect ratio with its 95 % bootstrap
     interval (bars) and quartiles (thin bars) at the median terminal q with its quartiles
     (horizontal bars), every seed faint behind (``frame``), over the steady branch
     (``branch``: a DataFrame as ``stability.branch.steady_branch`` returns, or None)."""
-    from .figures.terminal import branch_lines
-
     fig, ax = _axes(ax, (6.0, 4.0))
     ax.axhline(1.0, color="0.85", lw=0.8, zorder=0)
     if frame is not None:

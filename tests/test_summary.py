@@ -150,10 +150,10 @@ def test_summary_figures_draw_every_cell():
     assert len(wedges) == 1 + 1 + 2 + 2
     assert sorted(c.get_label() for c in fig.axes[0].collections
                   if not len(c.get_offsets())) == ["3D", "in-plane", "stable"]  # the legend
-    verts, scale = plots._wedge_marker(0.0, np.pi / 2)
+    verts, scale = plots.wedge_marker(0.0, np.pi / 2)
     assert scale == pytest.approx(1.0) and np.allclose(verts[1], [1, 0]) and np.allclose(
         verts[-2], [0, 1])
-    _, scale = plots._wedge_marker(np.pi / 4 - 0.1, np.pi / 4 + 0.1)
+    _, scale = plots.wedge_marker(np.pi / 4 - 0.1, np.pi / 4 + 0.1)
     assert scale == pytest.approx(np.cos(np.pi / 4 - 0.1) ** 2)  # the marker's rescaling undone
     assert fig.axes[0].get_title() == "regime probabilities per cell over 4 seeds"
     with pytest.raises(ValueError, match="style must be"):

@@ -2,7 +2,7 @@
 import numpy as np
 from matplotlib.ticker import MaxNLocator
 
-from ..plots import order_column, orders_text
+from ..plots import branch_lines, order_column, orders_text
 from .style import (
     ASPECT_LABEL, default_thresholds, new_figure, q_lines, scatter_regimes, single_axes,
 )
@@ -41,25 +41,6 @@ def q_and_tilt(frame, thresholds=None, axes=None, reference=None):
     fig.legend(handles, labels, fontsize=8, frameon=False, loc="outside lower center", ncol=3)
     fig.suptitle(f"initial against terminal state, {orders_text(frame)}", fontsize=10)
     return fig
-
-
-def branch_lines(ax, branch):
-    """The steady branch: solid where stable in and out of plane, dashed elsewhere."""
-    stable = (branch["stable_in_plane"].to_numpy(bool)
-              & branch["stable_out_of_plane"].to_numpy(bool))
-    q, ar = branch["q"].to_numpy(float), branch["aspect_ratio"].to_numpy(float)
-    order = branch.attrs.get("n")
-    for flag, style, label in ((True, "-", "steady shapes, stable"),
-                               (False, "--", "steady shapes, unstable")):
-        y = np.where(stable == flag, ar, np.nan)
-        # keep the segments joined where stability changes
-        joined = y.copy()
-        change = np.nonzero(stable[1:] != stable[:-1])[0]
-        joined[change + (0 if flag else 1)] = ar[change + (0 if flag else 1)]
-        joined[change + (1 if flag else 0)] = ar[change + (1 if flag else 0)]
-        if np.any(np.isfinite(joined)):
-            ax.plot(q, joined, color="k", ls=style, lw=1.3,
-                    label=label + (f" (n = {order})" if order else ""), zorder=2)
 
 
 def aspect_ratio(frame, branch=None, ax=None, reference=None, q_max=None):
