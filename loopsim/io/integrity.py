@@ -167,6 +167,10 @@ def read_table_checked(path, require_hash=False):
         raise DamagedFile(path, f"unreadable: {lines[0] if lines else type(exc).__name__}") \
             from None
     try:  # a flipped bit in the footer may leave names or metadata undecodable
+        # The footer as the other readers see it (pq.ParquetFile decodes the nested
+        # column paths, which read_table's Arrow schema does not need): a name there that
+        # is not UTF-8 is damage too, not a bare UnicodeDecodeError later.
+        pq.ParquetFile(path).reader.column_paths  # noqa: B018 - decoded for the check
         meta = {_text(k): _text(v) for k, v in (table.schema.metadata or {}).items()}
         stored = meta.get(CONTENT_KEY)
         matches = stored is not None and content_hash(table, meta) == stored

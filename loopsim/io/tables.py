@@ -10,7 +10,7 @@ import pyarrow.parquet as pq
 
 from .. import columns, diagnostics
 from .._version import __version__
-from .integrity import write_table_atomically
+from .integrity import DamagedFile, write_table_atomically
 
 
 COEFFICIENT_LAYOUT = (
@@ -110,11 +110,18 @@ def write_trajectory(result, path, command_line=None):
 
 
 def read_metadata(path):
-    """Decoded schema metadata of a loopsim Parquet file."""
-    raw = pq.read_schema(path).metadata or {}
+    """Decoded schema metadata of a loopsim Parquet file; ``integrity.DamagedFile`` naming
+    it where its footer cannot be read or decoded (OSError where it cannot be opened)."""
+    try:
+        raw = {key.decode(): value.decode()
+               for key, value in (pq.read_schema(path).metadata or {}).items()}
+    except (FileNotFoundError, PermissionError, IsADirectoryError):
+        raise
+    except Exception as exc:  # noqa: BLE001 - a footer we wrote that does not decode: damage
+        raise DamagedFile(path, f"unreadable footer: {type(exc).__name__}: {str(exc)[:80]}") \
+            from None
     out = {}
     for key, value in raw.items():
-        key, value = key.decode(), value.decode()
         try:
             out[key] = json.loads(value)
         except json.JSONDecodeError:
