@@ -284,6 +284,23 @@ def regime_pies(cells, ax, size=150):
                    label=REGIME_STYLE[regime]["label"])
 
 
+def check_one_cell_per_point(cells):
+    """ValueError naming the first (g0, θ0) that holds several cells of a summary table
+    (they differ in another input, say the model or rtol): a diagram over (θ0, g0) would
+    draw them on top of each other.  Returns ``cells``."""
+    repeated = cells[cells.duplicated(["g0", "theta0_deg"], keep=False)]
+    if len(repeated):
+        first = repeated.iloc[0]
+        others = [c for c in cells.attrs.get("loopsim_summary", {}).get("cells_by", [])
+                  if c not in ("g0", "theta0_deg")]
+        count = int(((cells["g0"] == first["g0"])
+                     & (cells["theta0_deg"] == first["theta0_deg"])).sum())
+        raise ValueError(f"the summary has {count} cells at g0 = {first['g0']:g}, theta0 = {first['theta0_deg']:g} "
+                         f"(they differ in {', '.join(others) or 'another input'}): one "
+                         "diagram draws one cell per point; filter the rows and draw each apart")
+    return cells
+
+
 def probability_phase_diagram(cells, frame=None, ax=None, style="pie"):
     """The phase diagram read as probabilities: each cell of a summary table
     (``loopsim.summarize``) at (θ0, g0) as a pie of its regime probabilities
@@ -293,6 +310,7 @@ def probability_phase_diagram(cells, frame=None, ax=None, style="pie"):
     (``q_c`` at n = 16)."""
     if style not in ("pie", "colour"):
         raise ValueError(f"style must be 'pie' or 'colour', got {style!r}")
+    check_one_cell_per_point(cells)
     fig, ax = _axes(ax, (6.8, 4.0))
     if style == "pie":
         regime_pies(cells, ax)

@@ -1,8 +1,11 @@
 """Outcomes as distributions: one row per cell of a sweep, from its seeds.
 
-A *cell* is one point of the sweep's inputs with the seed left out: every input column
-that takes more than one value in the table (``g0``, ``theta0_deg`` and whatever else
-was swept: ``n``, ``rtol``, ``perturbation`` ...).  Per cell:
+A *cell* is one point of the sweep's inputs with the seed left out: ``g0``,
+``theta0_deg`` and every other input column of :data:`CELL_INPUTS` that takes more than
+one value in the table (``model``, ``slenderness``, ``n``, ``rtol``, ``perturbation`` ...:
+whatever a grid or a cases file can set per case).  A cell holds each seed at most once:
+two rows with one seed in one cell differ in an input the table does not record (an
+``initial`` shape, say), and are refused rather than merged.  Per cell:
 
 * ``seeds``, ``resolved``, ``determined``: how many rows, and how many of them are
   resolved and determined (``loopsim.outcomes``);
@@ -27,12 +30,13 @@ from .outcomes import REGIMES
 #: z of a two-sided 95 % interval, Φ⁻¹(0.975).
 Z95 = 1.959963984540054
 BOOTSTRAP_RESAMPLES = 2000
-#: The inputs that may define a cell (the seed never does).
 #: The outcome columns summarised by quantiles, and their prefixes in the summary.
 OUTCOME_STATISTICS = (("theta_final_deg", "tilt"), ("aspect_ratio", "aspect"),
                       ("q_final", "q_final"))
-CELL_INPUTS = ("g0", "theta0_deg", "n", "t_end", "rtol", "atol", "w", "perturbation",
-               "method")
+#: The inputs that may define a cell (the seed never does): every input column of a
+#: results table that a grid, a sweep option or a cases-file column can set per case.
+CELL_INPUTS = ("g0", "theta0_deg", "model", "slenderness", "n", "t_end", "rtol", "atol", "w",
+               "perturbation", "method")
 
 
 def wilson_interval(successes, trials, z=Z95):
@@ -68,6 +72,30 @@ def cell_columns(frame):
                                                       or frame[c].nunique(dropna=False) > 1)]
 
 
+def _key(key):
+    """A groupby key as a tuple whose missing values (NaN, None) compare equal, so that
+    cells of two tables pair up (NaN != NaN)."""
+    key = key if isinstance(key, tuple) else (key,)
+    return tuple(None if pd.isna(value) else value for value in key)
+
+
+def cell_groups(frame, by):
+    """[(key, rows)] of ``frame`` grouped into cells by the columns ``by`` (missing values a
+    value of their own; keys as :func:`_key`); ValueError naming the first cell that holds
+    one seed twice (rows that differ in an input the table does not tell apart)."""
+    groups = [(_key(key), rows) for key, rows in frame.groupby(by, sort=True, dropna=False)]
+    if "seed" in frame:
+        for key, rows in groups:
+            counts = rows["seed"].value_counts()
+            if counts.max() > 1:
+                cell = ", ".join(f"{c}={v}" for c, v in zip(by, key))
+                raise ValueError(
+                    f"cell ({cell}) holds seed {int(counts.idxmax())} {int(counts.max())} "
+                    f"times: its rows differ in an input not among {list(by)} (a given "
+                    "initial shape?); summarise them apart, or pass by= with that input")
+    return groups
+
+
 def _cell_row(rows, seed):
     trials = len(rows)
     out = dict(seeds=trials, resolved=int(rows["resolved"].sum()),
@@ -100,8 +128,7 @@ def summarize(frame, by=None, seed=0):
         raise ValueError(f"no column(s) {missing} to group the cells by")
     if not len(frame):
         raise ValueError("no rows to summarise")
-    rows = [dict(zip(by, key if isinstance(key, tuple) else (key,)), **_cell_row(group, seed))
-            for key, group in frame.groupby(by, sort=True, dropna=False)]
+    rows = [dict(zip(by, key), **_cell_row(group, seed)) for key, group in cell_groups(frame, by)]
     table = pd.DataFrame(rows)
     table.attrs["loopsim_summary"] = dict(cells_by=by, bootstrap_seed=seed,
                                           bootstrap_resamples=BOOTSTRAP_RESAMPLES,
@@ -115,16 +142,18 @@ SAME, DIFFERENT = "indistinguishable at this sample size", "different"
 
 
 def _paired_cells(a, b, by):
+    """The pairing columns (default: g0, theta0_deg and every input that varies within
+    either table: a cell is never merged with another) and the [(key, rows_a, rows_b)] of
+    the cells both tables hold."""
     if by is None:
-        common = [c for c in CELL_INPUTS if c in a and c in b]
-        by = [c for c in common if c in ("g0", "theta0_deg")
-              or (set(a[c].unique()) == set(b[c].unique()) and a[c].nunique() > 1)]
+        by = [c for c in CELL_INPUTS if c in ("g0", "theta0_deg") or any(
+            c in t and t[c].nunique(dropna=False) > 1 for t in (a, b))]
     missing = [c for c in by if c not in a or c not in b]
     if missing:
-        raise ValueError(f"no column(s) {missing} in both tables to pair the cells by")
-    groups_b = dict(iter(b.groupby(by, sort=True, dropna=False)))
-    pairs = [(key, rows, groups_b[key]) for key, rows in a.groupby(by, sort=True, dropna=False)
-             if key in groups_b]
+        raise ValueError(f"no column(s) {missing} in both tables to pair the cells by "
+                         "(an input varies within one table only: pass by=)")
+    groups_b = dict(cell_groups(b, by))
+    pairs = [(key, rows, groups_b[key]) for key, rows in cell_groups(a, by) if key in groups_b]
     if not pairs:
         raise ValueError(f"the two tables share no cell (by {by})")
     return by, pairs
@@ -159,8 +188,7 @@ def compare(a, b, by=None, alpha=0.05, seed=0, resamples=500):
     by, pairs = _paired_cells(a, b, by)
     rows = []
     for key, rows_a, rows_b in pairs:
-        out = dict(zip(by, key if isinstance(key, tuple) else (key,)),
-                   seeds_a=len(rows_a), seeds_b=len(rows_b))
+        out = dict(zip(by, key), seeds_a=len(rows_a), seeds_b=len(rows_b))
         for column, short in (("theta_final_deg", "tilt"), ("aspect_ratio", "aspect")):
             x, y = rows_a[column].to_numpy(float), rows_b[column].to_numpy(float)
             x, y = x[np.isfinite(x)], y[np.isfinite(y)]

@@ -177,3 +177,60 @@ def test_summary_figures_draw_every_cell():
     fig = plots.distribution_summary(cells, frame, branch=branch)
     assert [a.get_title() for a in fig.axes[:3]][1:] == ["terminal tilt over seeds",
                                                         "terminal shape over seeds"]
+
+
+def _model_rows(model, slenderness, tilts, g0=100.0):
+    return [dict(g0=g0, theta0_deg=60.0, n=8, seed=seed, model=model, slenderness=slenderness,
+                 rtol=1e-6, regime="3d", resolved=True, determined=True, theta_final_deg=tilt,
+                 aspect_ratio=2.0, nfev=1, twin_nfev=0, wall_s=0.1)
+            for seed, tilt in enumerate(tilts)]
+
+
+def test_cells_are_kept_apart_by_model_and_slenderness():
+    """Issue 36.1: rows of two slenderness values (and a local row) at one point are three
+    cells, never one: the two slenderness values end at 65-79 and 15-22 degrees."""
+    frame = pd.DataFrame(_model_rows("nonlocal", 1e-2, [64.9, 72.0, 79.1])
+                         + _model_rows("nonlocal", 1e-3, [15.4, 18.0, 22.4])
+                         + _model_rows("local", np.nan, [40.0]))
+    table = summary.summarize(frame)
+    assert table.attrs["loopsim_summary"]["cells_by"] == ["g0", "theta0_deg", "model",
+                                                          "slenderness"]
+    assert len(table) == 3 and list(table["seeds"]) == [1, 3, 3]
+    by_eps = table.set_index("slenderness")["tilt_median"]
+    assert by_eps[1e-2] == 72.0 and by_eps[1e-3] == 18.0
+    assert table.loc[table["model"] == "local", "tilt_median"].item() == 40.0
+    # compare pairs cell with cell, the local row never merged into a nonlocal cell
+    pairs = summary.compare(frame, frame.assign(theta_final_deg=frame["theta_final_deg"] + 1))
+    assert len(pairs) == 3 and list(pairs["seeds_a"]) == [1, 3, 3]
+    # one table sweeping the slenderness, the other not: only the shared cell pairs
+    other = pd.DataFrame(_model_rows("nonlocal", 1e-3, [15.0, 18.5, 22.0]))
+    pairs = summary.compare(frame, other)
+    assert len(pairs) == 1 and pairs["slenderness"].item() == 1e-3
+
+
+def test_a_cell_holding_one_seed_twice_is_refused():
+    """Rows that differ in an input the table does not record (two initial shapes, seed 0
+    each) are not one cell of two seeds."""
+    frame = pd.DataFrame(_model_rows("local", np.nan, [10.0]) * 2)
+    with pytest.raises(ValueError, match=r"holds seed 0 2 times"):
+        summary.summarize(frame)
+    with pytest.raises(ValueError, match=r"holds seed 0 2 times"):
+        summary.compare(frame, frame)
+
+
+def test_summary_figure_of_cells_sharing_a_point_is_refused_before_writing(tmp_path, capsys):
+    """Two rtol at one point are two cells; one diagram cannot draw both: refused in one
+    line before the table or the figure is written."""
+    cases = tmp_path / "cases.csv"
+    cases.write_text("g0,theta0_deg,n,seed,rtol\n10,30,4,0,1e-6\n10,30,4,0,1e-7\n")
+    out = tmp_path / "s"
+    assert main(["sweep", "--cases", str(cases), "--t-end", "0.2", "--no-twin", "--quiet",
+                 "--threads", "1", "--out", str(out)]) == 0
+    capsys.readouterr()
+    table, figure = tmp_path / "cells.parquet", tmp_path / "cells.png"
+    assert main(["summary", str(out), "--out", str(table), "--figure", str(figure)]) == 2
+    err = capsys.readouterr().err
+    assert "2 cells at g0 = 10, theta0 = 30 (they differ in rtol)" in err, err
+    assert not table.exists() and not figure.exists()
+    assert main(["summary", str(out), "--out", str(table)]) == 0
+    assert list(pd.read_parquet(table)["rtol"]) == [1e-7, 1e-6]
