@@ -204,10 +204,15 @@ def model_outcomes(frames):
 
 
 def save(fig, path, dpi=200):
-    """Write ``fig`` to ``path`` (its directory made if absent) and close it."""
-    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
-    fig.savefig(path, dpi=dpi)
-    plt.close(fig)
+    """Write ``fig`` to ``path`` (its directory made if absent; atomically: a failed write
+    leaves no file) and close it."""
+    from . import io
+
+    try:
+        io.write_file_atomically(path, lambda tmp: fig.savefig(
+            tmp, dpi=dpi, format=os.path.splitext(path)[1][1:] or None))
+    finally:
+        plt.close(fig)
     return path
 
 

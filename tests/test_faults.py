@@ -339,6 +339,30 @@ def test_refused_rerun_options_leave_the_directory_usable(sweep, capsys):
     assert main(["sweep", "--rerun-failed", sweep, "--method", "radau5", "--quiet"]) == 0
 
 
+@pytest.mark.parametrize("option", [["--model", "nonlocal"], ["--slenderness", "0"],
+                                    ["--slenderness", "1e-3"], ["--p-halfwidth", "0.1"]])
+def test_rerun_refuses_every_option_it_would_ignore(sweep, capsys, option):
+    """Issue 36.6: --model and --slenderness (any value, 0 included) are refused like every
+    other option that is not --method, --rtol or --atol, and nothing is recorded."""
+    before = open(os.path.join(sweep, io.SWEEP_FILE)).read()
+    assert main(["sweep", "--rerun-failed", sweep, "--method", "radau5", *option]) == 2
+    err = capsys.readouterr().err
+    assert f"{option[0]} does not apply with --rerun-failed" in err, err
+    assert open(os.path.join(sweep, io.SWEEP_FILE)).read() == before
+
+
+def test_cases_file_slenderness_of_a_local_row_is_refused(tmp_path, capsys):
+    """Issue 36.10: a row of model local with a slenderness is refused in one line, as the
+    command line refuses the pair, instead of dropping the slenderness."""
+    path = tmp_path / "cases.csv"
+    path.write_text("g0,theta0_deg,model,slenderness\n10,30,nonlocal,1e-3\n"
+                    "10,30,local,1e-3\n")
+    assert main(["sweep", "--cases", str(path), "--out", str(tmp_path / "s")]) == 2
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1 and "case 1" in err and "'local'" in err, err
+    assert not (tmp_path / "s").exists()
+
+
 def test_point_files_bounded_by_size_rows_and_kind(tmp_path, capsys):
     fifo = str(tmp_path / "fifo")
     os.mkfifo(fifo)  # opening it would block: refused from its kind
@@ -487,6 +511,34 @@ def test_disk_full_is_an_environment_error_and_the_sweep_resumes(tmp_path, capsy
     monkeypatch.setattr(parquet, "write_table", real_write)
     assert main(argv) == 0
     assert len(loopsim.read_results(str(out))) == 2
+
+
+@pytest.mark.parametrize("command", ["summary", "figures"])
+def test_disk_full_leaves_no_empty_figure(sweep, tmp_path, capsys, monkeypatch, command):
+    """Issue 36.11: a figure that cannot be written (ENOSPC) exits 3 and leaves no PNG, not
+    a 0-byte one, and no temporary."""
+    import errno
+
+    from matplotlib.figure import Figure
+
+    def no_space(self, fname, *args, **kwargs):
+        with open(fname, "wb"):  # what a full disk leaves: the file made, nothing in it
+            pass
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(Figure, "savefig", no_space)
+    figures = tmp_path / "figs"
+    argv = (["summary", sweep, "--figure", str(figures / "cells.png")] if command == "summary"
+            else ["figures", sweep, "--out", str(figures), "--only", "phase"])
+    if command == "summary":
+        figures.mkdir()
+    assert main(argv) == 3
+    assert "No space left on device" in capsys.readouterr().err
+    assert listing_of(figures) == []
+
+
+def listing_of(path):
+    return sorted(os.listdir(path)) if os.path.isdir(path) else []
 
 
 def test_output_that_takes_no_files_is_refused_before_work(tmp_path, capsys, monkeypatch):

@@ -117,6 +117,9 @@ SEED_TARGET_HELP = {
     "max_seeds": ("K", "seeds at most per point"),
 }
 RERUN_OPTIONS = ("method", "rtol", "atol")  # what --rerun-failed takes from the command line
+#: Options that say where and how a rerun runs, not what: they apply with --rerun-failed.
+RERUN_BACKEND = ("rerun_failed", "threads", "quiet", "progress_every", "scheduler", "dask",
+                 "workers", "figure")
 
 
 def _parse_shard(text):
@@ -204,11 +207,8 @@ def _check_rerun_options(args):
     parser = Parser(prog="loopsim")  # the sweep command alone: its defaults
     add_parser(parser.add_subparsers(dest="command", required=True, parser_class=Parser))
     defaults = vars(parser.parse_args(["sweep"]))
-    ignored = [key for key in ("g0", "theta0", "cases", "n", "seeds", "t_end", "w", "perturbation",
-                               "no_early_stop", "snapshots_for", "snapshots", "chunk_size",
-                               "shard", "out", "n_max", "tail_tol", "no_twin", "p_halfwidth",
-                               "tilt_halfwidth", "min_seeds", "max_seeds")
-               if getattr(args, key) != defaults[key]]
+    ignored = [key for key in defaults if key not in ("command",) + RERUN_OPTIONS + RERUN_BACKEND
+               and getattr(args, key) != defaults[key]]
     if ignored:
         raise ValueError(f"--{ignored[0].replace('_', '-')} does not apply with --rerun-failed "
                          f"(the cases and settings come from the sweep; only "

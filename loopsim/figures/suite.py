@@ -1,12 +1,11 @@
 """``loopsim figures``: read sweeps and run files and write every figure they allow as PNG."""
 import os
 
-import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 
 from .. import validation
-from ..plots import orders_text, phase_diagram
+from ..plots import orders_text, phase_diagram, save as save_figure
 from .evolution import evolution, evolution_rows, tension_figure
 from .gallery import gallery
 from .linear import load_branch, stability, stability_data
@@ -119,9 +118,7 @@ def write_figures(sweep_dir, others=(), out=".", only=None, gallery_theta0=30.0,
     written = {}
 
     def save(name, fig):
-        path = os.path.join(out, f"{name}.png")
-        fig.savefig(path, dpi=dpi)
-        plt.close(fig)
+        path = save_figure(fig, os.path.join(out, f"{name}.png"), dpi=dpi)
         written[name] = path
         log(f"{name}: {path}")
 

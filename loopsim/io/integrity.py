@@ -79,6 +79,21 @@ def write_json_atomically(data, path):
         raise
 
 
+def write_file_atomically(path, write):
+    """Call ``write(temporary_path)`` on a temporary file named for this process in the
+    target directory (with the target's extension), then rename it into place: a file
+    is there whole or not at all (a full disk leaves no empty or partial file)."""
+    fd, tmp = _temporary(os.path.dirname(os.path.abspath(path)), os.path.splitext(path)[1])
+    os.close(fd)
+    try:
+        write(tmp)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        raise
+
+
 def write_table_atomically(table, path):
     """Write to a temporary file in the target directory, then rename into place; with
     Parquet page checksums (CRC32) and :data:`CONTENT_KEY`, a SHA-256 of the content and

@@ -7,6 +7,7 @@ ordinary sweep directory per round (:data:`ROUND_DIR`), and, once every cell has
 """
 import json
 import os
+import re
 
 import pandas as pd
 
@@ -41,16 +42,67 @@ def read_seeds_file(out):
                          "sweep's cells and targets: restore it or use another --out") from None
 
 
+def _without(config, keys):
+    return {k: v for k, v in config.items() if k not in keys}
+
+
+def check_rounds(out, stored, count):
+    """ValueError naming the first of ``out``'s ``count`` round directories that is not
+    this sweep's: its configuration fingerprint is not the one recorded for it before it
+    ran (``stored["rounds"]``, the decoded record), or, in a directory recorded before
+    fingerprints were, its options differ from the record's or it holds a case of no cell."""
+    recorded = stored.get("rounds")
+    ignored = ("cases",) + sweepdir.FINGERPRINT_IGNORES
+    options = _without(stored["config"], ignored)
+    cells = [_without(case, ("seed",)) for case in stored["config"]["cases"]]
+    for index in range(count):
+        directory = round_directory(out, index)
+        config = sweepdir.read_sweep_file(directory)
+        if config is None:
+            continue  # a round cut short before it wrote its configuration: no rows
+        if recorded is not None:
+            foreign = index >= len(recorded) or config["fingerprint"] != recorded[index]
+        else:
+            foreign = _without(config["config"], ignored) != options or any(
+                _without(case, ("seed",)) not in cells for case in config["config"]["cases"])
+        if foreign:
+            raise ValueError(f"{directory!r} is not a round of the --seeds auto sweep in "
+                             f"{out!r} (its cases or options are not the ones this sweep "
+                             "planned: copied in from another sweep?); move it away")
+
+
+def check_round_directory(out, fingerprint):
+    """ValueError when ``out`` is a ``--seeds auto`` directory, or one of its rounds about
+    to be run with a configuration (``fingerprint``) other than the one recorded for it:
+    a directory of one kind never takes a sweep of another."""
+    if is_seeds_auto(out):
+        raise ValueError(f"{out!r} holds a --seeds auto sweep; use another --out (or its "
+                         "--seeds auto command, to resume it)")
+    parent, name = os.path.split(os.path.abspath(out))
+    match = re.fullmatch(ROUND_DIR.replace("{:02d}", r"(\d{2,})"), name)
+    if match and is_seeds_auto(parent):
+        recorded = (read_seeds_file(parent) or {}).get("rounds") or []
+        index = int(match[1])
+        if index >= len(recorded) or recorded[index] != fingerprint:
+            raise ValueError(f"{out!r} is round {index} of the --seeds auto sweep in "
+                             f"{parent!r}, planned with other cases and options; use another "
+                             "--out")
+
+
 def read_seeds_auto(out):
     """Every round's rows of a ``--seeds auto`` directory as one DataFrame: each round read
     and checked by ``sweepdir.read_results``, a ``round`` column added, ``case_id``
     renumbered in (round, case_id) order; ``attrs["loopsim"]`` is the first round's, with
     the targets (``seeds_auto``) and the number of rounds."""
     stored = read_seeds_file(out)
+    count = 0
+    while os.path.isdir(round_directory(out, count)):
+        count += 1
+    check_rounds(out, stored, count)
     frames = []
-    while os.path.isdir(round_directory(out, len(frames))):
-        frame = sweepdir.read_results(round_directory(out, len(frames)))
-        frames.append(frame.assign(round=len(frames)))
+    for index in range(count):
+        frame = sweepdir.read_results(round_directory(out, index))
+        frames.append(frame.assign(round=index))
     if not frames:
         raise ValueError(f"{out!r} is a --seeds auto directory with no round yet: run its "
                          "command")

@@ -242,6 +242,11 @@ def validate(config):
                     validation.check_real(key, case[key], low=0.0, low_open=True)
             if "method" in case:
                 validation.check_choice("method", case["method"], refinement.METHOD_CHOICES)
+            if case.get("slenderness") is not None and case_option(config, case,
+                                                                   "model") != "nonlocal":
+                raise ValueError(f"slenderness {case['slenderness']!r} applies only to the "
+                                 "nonlocal model, and this case's model is "
+                                 f"{case_option(config, case, 'model')!r}")
             models.check_order(case_model(config, case), case["n"],
                                "n_start" if config.n_auto else "n")
         except ValueError as exc:

@@ -30,9 +30,10 @@ def prepare_directory(out, config, command_line):
     side identical sweep) are redundant and removed; partial overlaps are refused.  Then
     only dead processes' temporaries are removed."""
     io.check_layout(out)
-    os.makedirs(out, exist_ok=True)
     current = json.loads(json.dumps(config.as_dict()))
     fingerprint = io.config_fingerprint(current)
+    io.check_round_directory(out, fingerprint)
+    os.makedirs(out, exist_ok=True)
     stored = io.read_sweep_file(out)
     if stored is not None and stored["fingerprint"] != fingerprint:
         previous = stored["config"]

@@ -34,6 +34,8 @@ def rerun_failed(out, method, rtol, atol, **backend):
         validation.check_choice("--method", method, refinement.METHOD_CHOICES)
     validation.check_real("--rtol", rtol, low=0.0, low_open=True)  # before anything is
     validation.check_real("--atol", atol, low=0.0)  # recorded: a refused rerun leaves no trace
+    if os.path.isdir(out) and io.is_seeds_auto(out):
+        return _rerun_rounds(out, method, rtol, atol, **backend)
     stored = io.read_sweep_file(out) if os.path.isdir(out) else None
     if stored is None:
         raise ValueError(f"no sweep at {out!r} (no {io.SWEEP_FILE}) to rerun failed cases of")
@@ -70,6 +72,27 @@ def rerun_failed(out, method, rtol, atol, **backend):
     open_attempt["merged"] = True
     io.write_json_atomically(stored, os.path.join(out, io.SWEEP_FILE))
     return io.read_results(out), len(ids)
+
+
+def _rerun_rounds(out, method, rtol, atol, **backend):
+    """:func:`rerun_failed` on a finished ``--seeds auto`` directory: each round with failed
+    cases is a sweep of its own, rerun in place.  The stop table stays as written (why
+    each cell stopped, with the rows it had then); ``read_results`` and ``summary`` read
+    the rows as they are now."""
+    if not os.path.isfile(os.path.join(out, io.STOPS_FILE)):
+        raise ValueError(f"the --seeds auto sweep in {out!r} has not finished: re-run its "
+                         "command first (its later rounds are planned from these rows)")
+    rows = io.read_results(out)  # every round checked before any rerun
+    reran = 0
+    for index in sorted(rows.loc[rows["status"] != "ok", "round"].unique()):
+        directory = io.round_directory(out, int(index))
+        stored = io.read_sweep_file(directory)
+        last = (stored.get("reruns") or [None])[-1]
+        settings = dict(method=method or stored["config"]["method"], rtol=rtol, atol=atol)
+        if last is not None and last["merged"] and last["settings"] == settings:
+            continue  # rerun with these settings by an earlier, interrupted call
+        reran += rerun_failed(directory, method, rtol, atol, **backend)[1]
+    return io.read_results(out), reran
 
 
 def _merge_rerun(out, fingerprint, directory, attempt, rows):

@@ -6,7 +6,10 @@ cell has stopped, the stop table: one row per cell saying why it stopped
 (``seeding``: deterministic, sharp or cap).  Round r's cases are planned from the rows of
 rounds < r only, by ``seeding.decide``; those rows are reproducible bit for bit, so
 re-running the command after an interruption plans the same rounds and resumes the one
-it stopped in.  Orchestration only: the rule is ``seeding``, the runs ``run_sweep``.
+it stopped in.  Each round's configuration fingerprint is recorded in the directory's
+record before the round runs, so that a round copied in from elsewhere is refused on
+read as on resume (``io.check_rounds``).  Orchestration only: the rule is ``seeding``,
+the runs ``run_sweep``.
 """
 import dataclasses
 import json
@@ -15,9 +18,12 @@ import os
 import pandas as pd
 import pyarrow as pa
 
-from .. import io, seeding
+from .. import io, seeding, validation
+from .cases import validate
 
-#: The inputs that tell the cells apart (the seed never does).
+#: The inputs that tell the cells apart (the seed never does).  Every other input of a
+#: cell (``summary.CELL_INPUTS``: model, slenderness, rtol, t_end, method, w ...) is one
+#: option of the whole sweep here: ``--seeds auto`` takes a grid, never a cases file.
 CELL_KEYS = ("g0", "theta0_deg", "n", "perturbation")
 _NO_ROWS = pd.DataFrame(dict(regime=[], theta_final_deg=[], aspect_ratio=[], seed=[]))
 
@@ -32,27 +38,77 @@ def _record(config, targets):
                 config=json.loads(json.dumps(config.as_dict())))
 
 
+def _differences(stored, record):
+    """The record's keys whose stored value differs (``io.FINGERPRINT_IGNORES`` left out:
+    the chunk size may change on resume)."""
+    changed = [f"targets.{k}" for k in record["targets"]
+               if stored.get("targets", {}).get(k) != record["targets"][k]]
+    changed += [k for k in record["config"] if k not in io.FINGERPRINT_IGNORES
+                and stored.get("config", {}).get(k) != record["config"][k]]
+    if stored.get("layout") != record["layout"] and not changed:
+        changed = ["its layout"]
+    return sorted(changed)
+
+
 def prepare(out, config, targets, command_line):
     """Make ``out`` for this ``--seeds auto`` sweep, or check that it holds this very one
-    (the same cells, targets and options); a one-line ValueError otherwise."""
+    (the same cells, targets and options, the chunk size aside); a one-line ValueError
+    otherwise.  Returns what it made (paths, deepest last) for :func:`_undo`."""
     record = _record(config, targets)
     stored = io.read_seeds_file(out)
     if stored is not None:
-        if {k: stored.get(k) for k in record} != record:
-            changed = sorted(
-                [f"targets.{k}" for k in record["targets"]
-                 if stored.get("targets", {}).get(k) != record["targets"][k]]
-                + [k for k in record["config"]
-                   if stored.get("config", {}).get(k) != record["config"][k]])
+        changed = _differences(stored, record)
+        if changed:
             raise ValueError(f"{out!r} holds a different --seeds auto sweep (differs in: "
-                             f"{', '.join(changed) or 'its layout'}); use another --out")
-        return
+                             f"{', '.join(changed)}); use another --out")
+        return []
     if os.path.isfile(os.path.join(out, io.SWEEP_FILE)):
         raise ValueError(f"{out!r} holds a sweep with fixed --seeds; use another --out")
+    made = []
+    missing = os.path.abspath(out)
+    while not os.path.exists(missing):
+        made.insert(0, missing)
+        missing = os.path.dirname(missing)
     os.makedirs(out, exist_ok=True)
-    io.write_json_atomically(dict(record, command_line=command_line or [],
+    io.write_json_atomically(dict(record, rounds=[], command_line=command_line or [],
                                   **json.loads(json.dumps(io.provenance()))),
                              os.path.join(out, io.SEEDS_FILE))
+    return made + [os.path.join(out, io.SEEDS_FILE)]
+
+
+def _undo(made):
+    """Remove what :func:`prepare` made (its record, then the directories it made, if
+    empty): a command refused before its first round leaves the file system as it was."""
+    for path in reversed(made):
+        try:
+            os.remove(path) if os.path.isfile(path) else os.rmdir(path)
+        except OSError:
+            return
+
+
+def _record_round(out, index, fingerprint):
+    """Record round ``index``'s fingerprint in the directory's record before it runs; a
+    ValueError if another one is recorded there (its rows would not be this sweep's)."""
+    stored = io.read_seeds_file(out)
+    rounds = stored.setdefault("rounds", [])
+    if index < len(rounds):
+        if rounds[index] != fingerprint:
+            raise ValueError(f"{io.round_directory(out, index)!r} was planned with other cases "
+                             "than this sweep's rows now ask for (a round replaced, or rows "
+                             "changed); use another --out")
+        return
+    stored["rounds"] = rounds + [fingerprint]
+    io.write_json_atomically(stored, os.path.join(out, io.SEEDS_FILE))
+
+
+def check_size(cells, targets):
+    """ValueError unless the most cases the sweep can reach (every cell at
+    ``max_seeds``) fit in one sweep's ``validation.MAX_CASES``: checked before any work."""
+    largest = len(cells) * targets.max_seeds
+    if largest > validation.MAX_CASES:
+        raise ValueError(f"--seeds auto could reach {len(cells)} points x --max-seeds "
+                         f"{targets.max_seeds} = {largest} cases, more than a sweep's "
+                         f"{validation.MAX_CASES}: lower --max-seeds or split the grid")
 
 
 def _groups(rows):
@@ -90,25 +146,39 @@ def run_seeds_auto(config, out, targets, *, run_round, command_line=None, announ
     ``config``: the sweep's configuration with one case per cell (its seed ignored);
     ``run_round(config, directory)``: runs one ordinary sweep and returns its rows (the
     caller's backend and progress); ``announce(text)``: called with one line per round.
+    Every input is checked before anything is written; a command that fails before its
+    first round leaves nothing behind.  A finished directory (its stop table written) is
+    read back, not planned again (a ``--rerun-failed`` may have replaced failed rows).
     """
     targets.check()
     cells = [dict(case, seed=0) for case in config.cases]
+    validate(dataclasses.replace(config, cases=cells))
     if len({cell_key(c) for c in cells}) != len(cells):
         raise ValueError("--seeds auto needs distinct cells (g0, theta0, n, perturbation)")
-    prepare(out, config, targets, command_line)
+    check_size(cells, targets)
+    made = prepare(out, config, targets, command_line)
+    if not made and os.path.isfile(os.path.join(out, io.STOPS_FILE)):
+        return io.read_seeds_auto(out), io.read_stop_table(out)
     rows = None
     index = 0
-    while True:
-        cases = plan_round(cells, rows, targets)
-        if not cases:
-            break
-        if announce is not None:
-            announce(f"seeds auto: round {index}: {len({cell_key(c) for c in cases})} of "
-                     f"{len(cells)} cells open, {len(cases)} cases")
-        frame = run_round(dataclasses.replace(config, cases=cases),
-                          io.round_directory(out, index)).assign(round=index)
-        rows = frame if rows is None else pd.concat([rows, frame], ignore_index=True)
-        index += 1
+    try:
+        while True:
+            cases = plan_round(cells, rows, targets)
+            if not cases:
+                break
+            if announce is not None:
+                announce(f"seeds auto: round {index}: {len({cell_key(c) for c in cases})} of "
+                         f"{len(cells)} cells open, {len(cases)} cases")
+            round_config = dataclasses.replace(config, cases=cases)
+            _record_round(out, index, io.config_fingerprint(
+                json.loads(json.dumps(round_config.as_dict()))))
+            frame = run_round(round_config, io.round_directory(out, index)).assign(round=index)
+            rows = frame if rows is None else pd.concat([rows, frame], ignore_index=True)
+            index += 1
+    except BaseException:
+        if made and not os.path.isdir(io.round_directory(out, 0)):
+            _undo(made)
+        raise
     table = stop_table(cells, rows, targets)
     meta = io.provenance(seeds_auto_targets=json.dumps(dataclasses.asdict(targets)))
     io.write_table_atomically(pa.Table.from_pandas(table, preserve_index=False)
