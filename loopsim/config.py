@@ -103,4 +103,5 @@ SEED_TARGETS = {
     "tilt_halfwidth": ("tilt_halfwidth_deg", 2.5),
     "min_seeds": ("min_seeds", 4),
     "max_seeds": ("max_seeds", 64),
+    "check_seeds": ("check_seeds", 8),
 }

@@ -11,6 +11,12 @@ seeds and doubles them, round after round, until one of these holds, checked in 
   at most ``tilt_halfwidth_deg``;
 * ``cap``: the cell has ``max_seeds`` seeds.
 
+A cell whose runs are *samples* (:func:`runs_are_samples`: its seeds end in different
+regimes, or some run's stricter twin ends elsewhere) needs no more twins: each would only
+prove once more that one run is a sample.  Its later seeds run without twins, and its
+distribution is checked instead against a subsample at the twins' stricter tolerances
+(``check_seeds`` seeds, ``sweeps.seeds_auto``; verdict by ``summary.compare``).
+
 The rule reads only a cell's finished rows, which are reproducible bit for bit, so the
 rounds it plans are too: a resumed ``--seeds auto`` sweep plans what the interrupted one
 did.  Seeds are numbered 0, 1, 2, ... in every cell, so a cell that stops at K seeds holds
@@ -40,6 +46,7 @@ class SeedTargets:
     max_seeds: int = SEED_TARGETS["max_seeds"][1]
     tilt_tol_deg: float = 1.0
     aspect_tol: float = 0.1
+    check_seeds: int = SEED_TARGETS["check_seeds"][1]
 
     def check(self):
         """A one-line ValueError naming the first bad target."""
@@ -53,6 +60,10 @@ class SeedTargets:
         if not 2 <= self.min_seeds <= self.max_seeds:
             raise ValueError(f"--min-seeds and --max-seeds must satisfy 2 <= min <= max, got "
                              f"{self.min_seeds!r} and {self.max_seeds!r}")
+        if not 0 <= self.check_seeds <= self.max_seeds and self.check_seeds != \
+                SEED_TARGETS["check_seeds"][1]:  # the default: as many as a cell has
+            raise ValueError(f"--check-seeds must be in 0..--max-seeds ({self.max_seeds}), "
+                             f"got {self.check_seeds!r}")
         return self
 
 
@@ -78,6 +89,13 @@ def is_deterministic(rows, targets):
     if not (np.isfinite(tilt).all() and np.isfinite(aspect).all()):
         return False
     return bool(np.ptp(tilt) <= targets.tilt_tol_deg and np.ptp(aspect) <= targets.aspect_tol)
+
+
+def runs_are_samples(rows):
+    """Whether a cell's runs are samples of a distribution rather than determined
+    trajectories: its seeds end in more than one regime, or a run's twin (at stricter
+    tolerances) ends elsewhere (``determined`` False)."""
+    return bool(rows["regime"].nunique() > 1 or rows["determined"].eq(False).any())
 
 
 def decide(rows, targets):

@@ -2,11 +2,12 @@
 rows of a fixed ``--seeds K`` sweep, rounds that double, and a bit-for-bit resume."""
 import dataclasses
 
+import numpy as np
 import pandas as pd
 import pytest
 
 import loopsim
-from loopsim import io, seeding, sweeps
+from loopsim import io, seeding, summary, sweeps
 from loopsim.io import STOPS_FILE, read_seeds_auto
 from loopsim.sweeps.seeds_auto import run_seeds_auto
 
@@ -21,7 +22,7 @@ def cells(g0, theta0, n=4):
 
 
 def runner(calls):
-    def run_round(config, directory):
+    def run_round(config, directory, weights=None):
         calls.append(len(config.cases))
         return sweeps.run_sweep(config, directory, threads=1, quiet=True)
     return run_round
@@ -56,7 +57,7 @@ def test_rounds_double_to_the_cap_and_resume_bit_for_bit(tmp_path):
     assert whole["round"].tolist() == [0] * 4 + [1] * 4 + [2] * 8
     assert sorted(whole.loc[whole["g0"] == 10.0, "seed"]) == list(range(8))
 
-    def interrupted(config, directory, _calls=[]):
+    def interrupted(config, directory, weights=None, _calls=[]):
         _calls.append(1)
         if len(_calls) == 2:
             raise KeyboardInterrupt
@@ -143,3 +144,85 @@ def test_seeds_auto_from_the_command_line(tmp_path, capsys):
         assert main(base + bad) == 2
         assert message in capsys.readouterr().err
     assert not (tmp_path / "bad").exists()
+
+
+def _rows(regimes, determined, round_=0):
+    return pd.DataFrame(dict(g0=150.0, theta0_deg=60.0, n=6, perturbation=0.01,
+                             seed=range(len(regimes)), regime=regimes, determined=determined,
+                             theta_final_deg=[10.0 + 7 * k for k in range(len(regimes))],
+                             aspect_ratio=2.0, nfev=100, twin_nfev=[
+                                 0 if d is None else 300 for d in determined],
+                             wall_s=1.0, round=round_))
+
+
+def test_runs_are_samples_when_seeds_disagree_or_a_twin_does():
+    assert not seeding.runs_are_samples(_rows(["3d"] * 4, [True] * 4))
+    assert seeding.runs_are_samples(_rows(["3d", "in-plane", "3d", "3d"], [True] * 4))
+    assert seeding.runs_are_samples(_rows(["3d"] * 4, [True, False, True, True]))
+    assert not seeding.runs_are_samples(_rows(["3d"] * 4, [None] * 4))  # no twins: no sign
+
+
+def test_sampled_cells_drop_their_twins_and_are_checked_in_distribution():
+    """A cell whose runs are samples plans its next seeds without twins and its check from
+    the seeds that had none; a cell of determined trajectories keeps its twins; the
+    expected costs come from the cells' rows (twins counted where they run)."""
+    from loopsim.sweeps import seeds_auto
+
+    targets = seeding.SeedTargets(check_seeds=3)
+    cell = dict(g0=150.0, theta0_deg=60.0, n=6, perturbation=0.01, seed=0)
+    first = _rows(["3d", "3d", "in-plane", "3d"], [True, False, True, True])
+    cases = seeds_auto.plan_round([cell], first, targets)
+    assert [c["seed"] for c in cases] == [4, 5, 6, 7] and all(c["twin"] is False for c in cases)
+    assert seeds_auto.plan_round([cell], first, targets, twins=False) == [
+        dict(cell, seed=s) for s in range(4, 8)]  # --no-twin: nothing to drop
+    assert seeds_auto.plan_round([cell], first, dataclasses.replace(targets, check_seeds=0)) \
+        == [dict(cell, seed=s) for s in range(4, 8)]  # no check: twins throughout
+    costs = seeds_auto.expected_costs(cases, first)
+    assert costs == {i: 1.0 for i in range(4)}
+    assert seeds_auto.expected_costs([cell], first) == {0: 4.0}  # with its twin: 1 + 300/100
+    assert seeds_auto.expected_costs([cell], None) is None
+    later = _rows(["3d"] * 4, [None] * 4).assign(seed=range(4, 8), round=1)
+    rows = pd.concat([first, later], ignore_index=True)
+    check = seeds_auto.plan_check([cell], rows, targets)
+    assert [c["seed"] for c in check] == [4, 5, 6]  # the untwinned seeds first
+    assert [c["seed"] for c in seeds_auto.plan_check(  # then the twinned ones, in seed order
+        [cell], rows, dataclasses.replace(targets, check_seeds=6))] == [0, 1, 4, 5, 6, 7]
+    config = sweeps.SweepConfig(cases=[cell], rtol=1e-6, atol=1e-9, tail_tol=1e-5)
+    strict = seeds_auto.check_config(config, check)
+    assert (strict.rtol, strict.atol, strict.tail_tol, strict.twin) == pytest.approx(
+        (1e-7, 1e-10, 1e-6, False))
+    steady = dict(cell, g0=10.0)
+    determined = _rows(["stable"] * 4, [True] * 4).assign(g0=10.0)
+    assert seeds_auto.plan_check([steady], determined, targets) == []
+    table = seeds_auto.stop_table([cell, steady], pd.concat([rows, determined]), targets,
+                                  checks=rows.iloc[4:7].assign(theta_final_deg=[40.0, 47, 54]))
+    sampled, settled = table.iloc[0], table.iloc[1]
+    assert (sampled["runs"], sampled["twins"], sampled["check_seeds"]) == ("samples", 4, 3)
+    assert sampled["check_verdict"] in (summary.SAME, summary.DIFFERENT)
+    assert 0 <= sampled["check_tilt_ks_p"] <= 1 and sampled["check_tilt_wasserstein"] > 0
+    assert (settled["runs"], settled["twins"], settled["check_seeds"]) == ("trajectories", 4, 0)
+    assert settled["check_verdict"] == "" and np.isnan(settled["check_tilt_ks_p"])
+
+
+def test_a_sampled_cell_end_to_end(tmp_path):
+    """Twins that can never agree (determined_tilt_deg 1e-15) make every run a sample:
+    round 0 runs twins, round 1 none, and the check reruns check_seeds seeds at 10x
+    stricter tolerances into out/check; the stop table says so."""
+    from loopsim.outcomes import Thresholds
+
+    config = sweeps.SweepConfig(cases=cells([60.0], [30.0]), t_end=0.3, method="rkf45",
+                                twin=True, chunk_size=2,
+                                thresholds=Thresholds(determined_tilt_deg=1e-15,
+                                                      determined_aspect=1e-15))
+    targets = seeding.SeedTargets(min_seeds=2, max_seeds=4, tilt_tol_deg=1e-12,
+                                  p_halfwidth=0.01, check_seeds=2)
+    out = tmp_path / "auto"
+    rows, stops = run_seeds_auto(config, str(out), targets, run_round=runner([]))
+    assert rows["twin_nfev"].gt(0).tolist() == [True, True, False, False]
+    assert rows["determined"].tolist()[:2] == [False, False]
+    check = loopsim.read_results(str(out / io.CHECK_DIR))
+    assert list(check["seed"]) == [2, 3] and set(check["rtol"]) == {config.rtol / 10}
+    stop = stops.iloc[0]
+    assert (stop["runs"], stop["twins"], stop["check_seeds"]) == ("samples", 2, 2)
+    assert stop["check_verdict"] == summary.SAME  # 10x stricter: the same tilts to 1e-5
+    pd.testing.assert_frame_equal(io.read_stop_table(str(out)), stops)

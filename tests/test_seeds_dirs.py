@@ -116,7 +116,7 @@ def test_a_resume_may_change_the_chunk_size(tmp_path):
                                   p_halfwidth=0.01)
     calls = []
 
-    def first_round_only(round_config, directory):
+    def first_round_only(round_config, directory, weights=None):
         calls.append(directory)
         if len(calls) == 2:
             raise KeyboardInterrupt
@@ -127,7 +127,7 @@ def test_a_resume_may_change_the_chunk_size(tmp_path):
         run_seeds_auto(config, out, targets, run_round=first_round_only)
     rows, stops = run_seeds_auto(
         dataclasses.replace(config, chunk_size=3), out, targets,
-        run_round=lambda c, d: sweeps.run_sweep(c, d, threads=1, quiet=True))
+        run_round=lambda c, d, w: sweeps.run_sweep(c, d, threads=1, quiet=True))
     assert len(rows) == 8 and list(stops["seeds"]) == [4, 4]
     with pytest.raises(ValueError, match="differs in: t_end"):
         run_seeds_auto(dataclasses.replace(config, t_end=0.2), out, targets,
@@ -141,7 +141,7 @@ def test_failed_cases_of_a_seeds_auto_directory_are_rerun(tmp_path, capsys):
     config = sweeps.SweepConfig(cases=sweeps.grid_cases([10.0], [30.0], [4], 1), t_end=3.0,
                                 max_steps=150, method="rkf45", twin=False)
     rows, stops = run_seeds_auto(config, out, seeding.SeedTargets(min_seeds=2, max_seeds=2),
-                                 run_round=lambda c, d: sweeps.run_sweep(c, d, threads=1,
+                                 run_round=lambda c, d, w: sweeps.run_sweep(c, d, threads=1,
                                                                          quiet=True))
     assert list(rows["status"]) == ["step budget exhausted"] * 2
     assert main(["sweep", "--rerun-failed", out, "--method", "radau5", "--quiet",

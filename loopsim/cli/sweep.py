@@ -115,6 +115,10 @@ SEED_TARGET_HELP = {
                        "bootstrap interval"),
     "min_seeds": ("K", "seeds of the first round"),
     "max_seeds": ("K", "seeds at most per point"),
+    "check_seeds": ("K", "seeds of each point whose runs are samples (its seeds end in "
+                    "different regimes, or a twin ends elsewhere) rerun at the twins' stricter "
+                    "tolerances to check its distribution (summary.compare); that point's "
+                    "later seeds run without twins; 0: no check, twins throughout"),
 }
 RERUN_OPTIONS = ("method", "rtol", "atol")  # what --rerun-failed takes from the command line
 #: Options that say where and how a rerun runs, not what: they apply with --rerun-failed.
@@ -259,8 +263,8 @@ def command(args):
             else:
                 frame, stops = sweeps.run_seeds_auto(
                     config, out, targets, command_line=sys.argv,
-                    run_round=lambda round_config, directory: sweeps.run_sweep(
-                        round_config, directory, **backend),
+                    run_round=lambda round_config, directory, weights: sweeps.run_sweep(
+                        round_config, directory, weights=weights, **backend),
                     announce=None if args.quiet else lambda line: print(
                         line, file=sys.stderr, flush=True))
     except KeyboardInterrupt as stopped:  # sweeps.SweepInterrupted, or a Ctrl-C before it
@@ -293,6 +297,16 @@ def command(args):
             f"{k} {v}" for k, v in sorted(reasons.items()))
             + f" (seeds per point {stops['seeds'].min()}-{stops['seeds'].max()}; why each "
             f"stopped: {out}/seeds_auto.parquet; per point: loopsim summary {out})")
+        sampled = stops[stops["runs"] == "samples"] if "runs" in stops else stops.iloc[:0]
+        checked = sampled[sampled["check_seeds"] > 0]
+        if len(sampled):
+            verdicts = ", ".join(f"{k} {v}" for k, v in
+                                 sorted(checked["check_verdict"].value_counts().items()))
+            check = (f"; their distributions checked against up to "
+                     f"{int(checked['check_seeds'].max())} seeds each at 10x stricter "
+                     f"tolerances ({out}/check): {verdicts}") if len(checked) else ""
+            print(f"{len(sampled)} points' runs are samples (seeds in several regimes, or a "
+                  f"twin ending elsewhere): their later seeds ran without twins{check}")
     if args.figure:
         use_agg()
         if seeds_auto:

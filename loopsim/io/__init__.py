@@ -24,8 +24,8 @@ from .sweepdir import (
     read_sweep_file, requires_hash, result_table, table_metadata,
 )
 from .seedsdir import (
-    ROUND_DIR, SEEDS_FILE, STOPS_FILE, check_round_directory, check_rounds, is_seeds_auto,
-    read_results, read_seeds_auto, read_seeds_file, read_stop_table, round_directory,
+    CHECK_DIR, ROUND_DIR, SEEDS_FILE, STOPS_FILE, check_round_directory, check_rounds,
+    is_seeds_auto, read_results, read_seeds_auto, read_seeds_file, read_stop_table, round_directory,
 )
 from .tables import (
     COEFFICIENT_LAYOUT, INPUT_FIELDS, OUTCOME_FIELDS, RESULT_SCHEMA, RUN_FIELDS, SUMMARY_FIELDS,
@@ -41,7 +41,7 @@ __all__ = [
     "overlapping", "provenance", "quarantine", "read_metadata", "read_results",
     "read_snapshots", "read_sweep_file", "read_table_checked", "remove_stale_temporaries",
     "requires_hash", "result_table", "table_metadata", "trajectory_table", "write_json_atomically",
-    "ROUND_DIR", "SEEDS_FILE", "STOPS_FILE", "check_round_directory", "check_rounds",
+    "CHECK_DIR", "ROUND_DIR", "SEEDS_FILE", "STOPS_FILE", "check_round_directory", "check_rounds",
     "is_seeds_auto", "read_seeds_auto",
     "read_seeds_file", "read_stop_table", "round_directory",
     "write_file_atomically", "write_table_atomically", "write_trajectory",

@@ -17,6 +17,8 @@ from .integrity import read_table_checked
 SEEDS_FILE = "_seeds_auto.json"
 STOPS_FILE = "seeds_auto.parquet"
 ROUND_DIR = "round-{:02d}"
+#: The distribution check of the cells whose runs are samples: an ordinary sweep directory.
+CHECK_DIR = "check"
 
 
 def is_seeds_auto(out):

@@ -166,7 +166,9 @@ def _case_row(path, i, row):
 
 
 def case_option(config, case, key):
-    """A case's ``rtol`` or ``t_end``: its own (a cases-file column) or the sweep's."""
+    """A case's ``rtol``, ``t_end``, ``model``, ``slenderness`` or ``twin``: its own (a
+    cases-file column; ``twin``: set by ``--seeds auto`` for a cell whose runs are samples)
+    or the sweep's."""
     return case.get(key, getattr(config, key))
 
 
@@ -242,6 +244,8 @@ def validate(config):
                     validation.check_real(key, case[key], low=0.0, low_open=True)
             if "method" in case:
                 validation.check_choice("method", case["method"], refinement.METHOD_CHOICES)
+            if "twin" in case and not isinstance(case["twin"], bool):
+                raise ValueError(f"twin must be True or False, got {case['twin']!r}")
             if case.get("slenderness") is not None and case_option(config, case,
                                                                    "model") != "nonlocal":
                 raise ValueError(f"slenderness {case['slenderness']!r} applies only to the "

@@ -8,6 +8,7 @@ import pyarrow as pa
 from .._blas import one_blas_thread
 from .directory import write_piece
 from .progress import failures
+from .chunks import chunk_case_ids
 from .runner import run_chunk
 
 
@@ -52,10 +53,12 @@ def _queue_worker(config, tasks, results, halt):
             return
 
 
-def run_local(config, out, fingerprint, pieces, threads, unit, progress, stop):
+def run_local(config, out, fingerprint, pieces, threads, unit, progress, stop, weights=None):
     """The pieces' cases on a work queue served by ``threads`` worker threads, one Numba
-    thread each: tasks of ``unit`` consecutive positions go, in position order, to
-    whichever worker is free, so a costly case holds up one core, not the others.  A
+    thread each: the pieces costliest first by ``weights`` ({case id: expected cost};
+    longest processing time first keeps every core busy to the end), each piece's tasks of
+    ``unit`` consecutive positions in position order, go to whichever worker is free, so a
+    costly case holds up one core, not the others.  A
     piece is written as soon as all its tasks are done.  On a stop request (or an
     error) no task starts any more; of each unfinished piece, the finished tasks from
     its start are written as one shorter piece and every later finished task as a piece
@@ -64,7 +67,11 @@ def run_local(config, out, fingerprint, pieces, threads, unit, progress, stop):
     run on, unseen, until the kernel returns)."""
     tasks, results, halt = queue.SimpleQueue(), queue.SimpleQueue(), threading.Event()
     count = 0
-    for index, piece in enumerate(pieces):
+    order = range(len(pieces)) if weights is None else sorted(
+        range(len(pieces)), key=lambda k: -sum(weights[i] for i in chunk_case_ids(
+            config, pieces[k])))
+    for index in order:
+        piece = pieces[index]
         for start in range(piece.start, piece.stop, unit):
             tasks.put((index, range(start, min(start + unit, piece.stop))))
             count += 1

@@ -21,7 +21,7 @@ from .stopping import SweepInterrupted, stop_event, stop_on_signals
 
 def run_sweep(config, out, threads=None, quiet=False, command_line=None, *, scheduler=None,
               local_cluster=False, workers=None, shard=None, unit=None, write="client",
-              progress_interval=30.0, stream=None):
+              progress_interval=30.0, stream=None, weights=None):
     """Run (or resume) a sweep into directory ``out``; returns the results DataFrame.
 
     Backends: this machine's cores (default; ``threads`` worker threads, default all
@@ -37,6 +37,10 @@ def run_sweep(config, out, threads=None, quiet=False, command_line=None, *, sche
     ``write`` (Dask): "client" (default: pieces come back and this process writes them;
     no shared filesystem needed) or "worker" (each worker writes its pieces into ``out``,
     which it must see at the same path); measured equal (docs/sweeps.md, "Dask and job arrays").
+    ``weights``: {case id: expected cost} (``--seeds auto`` passes its cells' measured
+    costs; default :func:`progress.case_weight`'s estimate): the local backend starts the
+    costliest pieces first, so that a heavy case does not run alone at the end, and the
+    ETA is weighted by them.
     """
     import numba
 
@@ -66,8 +70,10 @@ def run_sweep(config, out, threads=None, quiet=False, command_line=None, *, sche
                                      for k, c in enumerate(canonical_chunks(config))
                                      if shard is None or k % shard[1] == shard[0]])
         done = set(covered_ids(config, covered)) & set(mine)
-        progress = Progress({i: case_weight(config.cases[i], config.n_auto) for i in mine},
-                            done, quiet, stream, progress_interval)
+        if weights is None:
+            weights = {i: case_weight(case, config.n_auto) for i, case in enumerate(config.cases)}
+        progress = Progress({i: weights[i] for i in mine}, done, quiet, stream,
+                            progress_interval)
         with stop_on_signals(stop):
             if distributed and pieces:
                 run_dask(config, out, fingerprint, pieces, threads or (1 if cluster else None),
@@ -75,7 +81,7 @@ def run_sweep(config, out, threads=None, quiet=False, command_line=None, *, sche
             elif pieces:
                 threads = threads or numba.config.NUMBA_NUM_THREADS
                 run_local(config, out, fingerprint, pieces, threads, unit or 1, progress,
-                           stop)
+                          stop, weights)
     finally:
         if client is not None:
             grace = 1 if stop.is_set() else None  # on a signal: no waiting for tasks
@@ -135,8 +141,8 @@ def sweep(g0, theta0_deg, out, *, n=6, seeds=1, method=None, quiet=True, threads
     if seeds_auto:
         rows, _ = run_seeds_auto(
             config, os.fspath(out), seeding.SeedTargets(**targets),
-            run_round=lambda round_config, directory: run_sweep(round_config, directory,
-                                                                **backend),
+            run_round=lambda round_config, directory, weights: run_sweep(
+                round_config, directory, weights=weights, **backend),
             command_line=backend["command_line"])
         return rows
     return run_sweep(config, os.fspath(out), **backend)

@@ -93,7 +93,7 @@ def _traced_case(config, case_id):
             method=method, max_steps=config.max_steps, length_tol=config.length_tol,
             steady_tol=config.steady_tol if config.early_stop else None,
             steady_interval=config.steady_interval, n_max=config.n_max,
-            tail_tol=config.tail_tol, twin=config.twin, model=model.name,
+            tail_tol=config.tail_tol, twin=case_option(config, case, "twin"), model=model.name,
             slenderness=model.slenderness)
     row = _result_row(config, case_id, case, result.x[0], result.x_final, result.status_code,
                       [getattr(result, name) for name in integrators.COUNTS],
@@ -109,8 +109,8 @@ def _traced_case(config, case_id):
 
 def _group_order(item):
     """Groups of a chunk in a fixed order (the local model's slenderness None sorts first)."""
-    (model, n, method, rtol), _ = item
-    return (model.name, model.slenderness or 0.0, n, method, rtol)
+    (model, n, method, rtol, twin), _ = item
+    return (model.name, model.slenderness or 0.0, n, method, rtol, twin)
 
 
 def run_chunk(config, chunk, threads):
@@ -119,7 +119,8 @@ def run_chunk(config, chunk, threads):
     Returns (results Table in RESULT_SCHEMA, snapshots Table or None).  Cases
     without snapshots run in the batch kernel (``refinement.integrate_cases``: a fixed
     n is a ladder of one order; parallel over ``threads`` lanes, serial on one), grouped
-    by model, starting n, method and rtol; their ``wall_s`` is the batch's wall time x threads
+    by model, starting n, method, rtol and whether a twin runs; their ``wall_s`` is the
+    batch's wall time x threads
     shared in proportion to RHS evaluations (a single case: its own wall time).
     """
     ids = chunk_case_ids(config, chunk)
@@ -129,12 +130,12 @@ def run_chunk(config, chunk, threads):
         if case_id not in traced:
             case = config.cases[case_id]
             key = (case_model(config, case), case["n"], case_method(config, case),
-                   case_option(config, case, "rtol"))
+                   case_option(config, case, "rtol"), bool(case_option(config, case, "twin")))
             groups.setdefault(key, []).append(case_id)
     start = time.perf_counter()
     compiled = _jitcache.compile_seconds()
     outputs = []
-    for (model, n, method, rtol), members in sorted(groups.items(), key=_group_order):
+    for (model, n, method, rtol, twin), members in sorted(groups.items(), key=_group_order):
         cases = [config.cases[i] for i in members]
         x0 = [shapes.start_shape(**_start(c))[0] for c in cases]
         run = functools.partial(
@@ -147,7 +148,7 @@ def run_chunk(config, chunk, threads):
         options = config.step_options()._replace(rtol=float(rtol))
         result = run(options=options, tail_tol=config.tail_tol)
         twins = None
-        if config.twin:
+        if twin:
             twin_rtol, twin_atol, twin_tail = outcomes.twin_tolerances(
                 options.rtol, options.atol, config.tail_tol)
             twins = run(options=options._replace(rtol=twin_rtol, atol=twin_atol),

@@ -18,7 +18,7 @@ import os
 import pandas as pd
 import pyarrow as pa
 
-from .. import io, seeding, validation
+from .. import io, outcomes, seeding, summary, validation
 from .cases import validate
 
 #: The inputs that tell the cells apart (the seed never does).  Every other input of a
@@ -41,8 +41,9 @@ def _record(config, targets):
 def _differences(stored, record):
     """The record's keys whose stored value differs (``io.FINGERPRINT_IGNORES`` left out:
     the chunk size may change on resume)."""
+    defaults = dataclasses.asdict(seeding.SeedTargets())
     changed = [f"targets.{k}" for k in record["targets"]
-               if stored.get("targets", {}).get(k) != record["targets"][k]]
+               if stored.get("targets", {}).get(k, defaults[k]) != record["targets"][k]]
     changed += [k for k in record["config"] if k not in io.FINGERPRINT_IGNORES
                 and stored.get("config", {}).get(k) != record["config"][k]]
     if stored.get("layout") != record["layout"] and not changed:
@@ -117,35 +118,116 @@ def _groups(rows):
     return {key: group.sort_values("seed") for key, group in rows.groupby(list(CELL_KEYS))}
 
 
-def plan_round(cells, rows, targets):
+def _sampled(rows, targets):
+    """Whether a cell with finished ``rows`` is checked in distribution (and so runs its
+    later seeds without twins): its runs are samples and ``check_seeds`` > 0."""
+    return targets.check_seeds > 0 and len(rows) > 0 and seeding.runs_are_samples(rows)
+
+
+def plan_round(cells, rows, targets, twins=True):
     """The next round's cases: for each cell (a case dict; its seed is ignored) whose rows
     so far (``rows``, a DataFrame or None) do not decide it, the seeds from its count up to
-    the size ``seeding.decide`` asks for."""
+    the size ``seeding.decide`` asks for; without twins (``twin=False``) where the sweep
+    runs them (``twins``) but the cell's runs are samples."""
     groups = _groups(rows)
     cases = []
     for cell in cells:
         have = groups.get(cell_key(cell), _NO_ROWS)
         reason, wanted = seeding.decide(have, targets)
         if reason == seeding.CONTINUE:
-            cases.extend(dict(cell, seed=seed) for seed in range(len(have), wanted))
+            extra = dict(twin=False) if twins and _sampled(have, targets) else {}
+            cases.extend(dict(cell, seed=seed, **extra) for seed in range(len(have), wanted))
     return cases
 
 
-def stop_table(cells, rows, targets):
-    """One row per cell: its inputs, seeds, rounds, stop reason and interval half-widths."""
+def expected_costs(cases, rows, twins=True):
+    """{case index: expected seconds} of a round's cases from their cells' finished rows:
+    the mean of ``wall_s``, scaled by (nfev + twin_nfev) / nfev where the case runs its
+    twin (``twins`` and not ``twin=False``); None for a round with a cell that has no rows
+    yet (the first)."""
     groups = _groups(rows)
-    return pd.DataFrame([
-        seeding.cell_record(CELL_KEYS, cell_key(cell), groups[cell_key(cell)], targets,
-                            int(groups[cell_key(cell)]["round"].max()) + 1)
+    costs = {}
+    for i, case in enumerate(cases):
+        have = groups.get(cell_key(case))
+        if have is None or not len(have):
+            return None
+        nfev = have["nfev"].to_numpy(float).clip(1.0)
+        twin = (1.0 + have["twin_nfev"].to_numpy(float) / nfev
+                if twins and case.get("twin", True) else 1.0)
+        costs[i] = float((have["wall_s"].to_numpy(float) * twin).mean())
+    return costs
+
+
+def plan_check(cells, rows, targets):
+    """The distribution check's cases: for each sampled cell (:func:`_sampled`), up to
+    ``check_seeds`` of its seeds, those that ran without a twin first (a twin is already
+    the stricter run of its seed), each in seed order."""
+    groups = _groups(rows)
+    cases = []
+    for cell in cells:
+        have = groups[cell_key(cell)]
+        if _sampled(have, targets):
+            order = have.assign(twinned=have["determined"].notna()).sort_values(
+                ["twinned", "seed"], kind="stable")
+            seeds = sorted(int(s) for s in order["seed"].iloc[:targets.check_seeds])
+            cases.extend(dict(cell, seed=seed) for seed in seeds)
+    return cases
+
+
+def check_config(config, cases):
+    """The check's configuration: ``cases`` at the twins' stricter tolerances
+    (``outcomes.twin_tolerances``), without twins."""
+    rtol, atol, tail_tol = outcomes.twin_tolerances(config.rtol, config.atol, config.tail_tol)
+    return dataclasses.replace(config, cases=cases, rtol=rtol, atol=atol, tail_tol=tail_tol,
+                               twin=False)
+
+
+#: The check's columns in the stop table, from ``summary.compare``.
+CHECK_COLUMNS = {"seeds_b": "check_seeds", "verdict": "check_verdict",
+                 "tilt_ks_p": "check_tilt_ks_p", "aspect_ks_p": "check_aspect_ks_p",
+                 "regime_p": "check_regime_p", "tilt_wasserstein": "check_tilt_wasserstein"}
+
+
+def stop_table(cells, rows, targets, checks=None):
+    """One row per cell: its inputs, seeds, rounds, stop reason and interval half-widths;
+    how its answer was decided (``runs``: "trajectories", each twin-checked or
+    deterministic, or "samples"; ``twins``: rows with a twin) and, for sampled cells, the
+    distribution check against its stricter subsample (``checks``: the check's rows)."""
+    groups = _groups(rows)
+    table = pd.DataFrame([
+        dict(seeding.cell_record(CELL_KEYS, cell_key(cell), groups[cell_key(cell)], targets,
+                                 int(groups[cell_key(cell)]["round"].max()) + 1),
+             runs="samples" if seeding.runs_are_samples(groups[cell_key(cell)])
+             else "trajectories",
+             twins=int(groups[cell_key(cell)]["determined"].notna().sum()))
         for cell in cells])
+    empty = dict(check_seeds=0, check_verdict="", **{
+        name: float("nan") for name in CHECK_COLUMNS.values()
+        if name not in ("check_seeds", "check_verdict")})
+    table = table.assign(**empty)
+    if checks is not None and len(checks):
+        sampled = pd.concat([groups[cell_key(cell)] for cell in cells
+                             if _sampled(groups[cell_key(cell)], targets)])
+        verdicts = summary.compare(sampled, checks, by=list(CELL_KEYS)).rename(
+            columns=CHECK_COLUMNS)
+        keys = list(CELL_KEYS)
+        table = table.drop(columns=list(CHECK_COLUMNS.values())).merge(
+            verdicts[keys + list(CHECK_COLUMNS.values())], on=keys, how="left")
+        table["check_seeds"] = table["check_seeds"].fillna(0).astype("int64")
+        table["check_verdict"] = table["check_verdict"].fillna("")
+    return table
 
 
 def run_seeds_auto(config, out, targets, *, run_round, command_line=None, announce=None):
     """Run (or resume) ``--seeds auto`` into ``out``; returns (rows, stop table).
 
     ``config``: the sweep's configuration with one case per cell (its seed ignored);
-    ``run_round(config, directory)``: runs one ordinary sweep and returns its rows (the
-    caller's backend and progress); ``announce(text)``: called with one line per round.
+    ``run_round(config, directory, weights)``: runs one ordinary sweep and returns its
+    rows (the caller's backend and progress; ``weights``: the cases' expected costs, or
+    None, for ``run_sweep``); ``announce(text)``: called with one line per round.  Once
+    every cell has stopped, the cells whose runs are samples are checked in distribution
+    (:func:`plan_check`, in ``out/check``; not with ``config.twin`` False: no stricter
+    runs at all) and the stop table records the verdicts.
     Every input is checked before anything is written; a command that fails before its
     first round leaves nothing behind.  A finished directory (its stop table written) is
     read back, not planned again (a ``--rerun-failed`` may have replaced failed rows).
@@ -163,23 +245,36 @@ def run_seeds_auto(config, out, targets, *, run_round, command_line=None, announ
     index = 0
     try:
         while True:
-            cases = plan_round(cells, rows, targets)
+            cases = plan_round(cells, rows, targets, twins=config.twin)
             if not cases:
                 break
             if announce is not None:
+                sampled = sum(not c.get("twin", True) for c in cases)
                 announce(f"seeds auto: round {index}: {len({cell_key(c) for c in cases})} of "
-                         f"{len(cells)} cells open, {len(cases)} cases")
+                         f"{len(cells)} cells open, {len(cases)} cases"
+                         + (f" ({sampled} without twins: their cells' runs are samples)"
+                            if sampled else ""))
             round_config = dataclasses.replace(config, cases=cases)
             _record_round(out, index, io.config_fingerprint(
                 json.loads(json.dumps(round_config.as_dict()))))
-            frame = run_round(round_config, io.round_directory(out, index)).assign(round=index)
+            frame = run_round(round_config, io.round_directory(out, index),
+                              expected_costs(cases, rows, config.twin)).assign(round=index)
             rows = frame if rows is None else pd.concat([rows, frame], ignore_index=True)
             index += 1
     except BaseException:
         if made and not os.path.isdir(io.round_directory(out, 0)):
             _undo(made)
         raise
-    table = stop_table(cells, rows, targets)
+    checks = None
+    cases = plan_check(cells, rows, targets) if config.twin else []  # --no-twin: no check
+    if cases:
+        if announce is not None:
+            announce(f"seeds auto: distribution check: {len({cell_key(c) for c in cases})} "
+                     f"cells whose runs are samples, {len(cases)} cases at 10x stricter "
+                     "tolerances")
+        checks = run_round(check_config(config, cases), os.path.join(out, io.CHECK_DIR),
+                           expected_costs(cases, rows, twins=False))
+    table = stop_table(cells, rows, targets, checks)
     meta = io.provenance(seeds_auto_targets=json.dumps(dataclasses.asdict(targets)))
     io.write_table_atomically(pa.Table.from_pandas(table, preserve_index=False)
                               .replace_schema_metadata(meta), os.path.join(out, io.STOPS_FILE))
