@@ -373,3 +373,29 @@ def test_cases_file_sets_method_rtol_and_t_end_per_row(tmp_path, capsys):
     assert main(["sweep", "--cases", str(path), "--out", str(tmp_path / "bad")]) == 2
     err = capsys.readouterr().err
     assert "row 0, column method" in err and "euler" in err
+
+
+def test_local_backend_starts_the_costliest_pieces_first(tmp_path, monkeypatch):
+    """Longest processing time first: with expected costs given, one worker takes the
+    pieces in descending total weight (positions in order within a piece); the table is
+    the one a sweep in position order writes."""
+    from loopsim.sweeps import local
+
+    config = sweeps.SweepConfig(cases=sweeps.grid_cases([10.0, 20.0, 30.0, 40.0], [30.0], [4],
+                                                        seeds=1), t_end=0.1, chunk_size=1)
+    started = []
+    real = local.run_chunk
+
+    def recording(config, part, threads):
+        started.append(sweeps.chunk_case_ids(config, part))
+        return real(config, part, threads)
+
+    monkeypatch.setattr(local, "run_chunk", recording)
+    weights = {0: 1.0, 1: 5.0, 2: 3.0, 3: 8.0}
+    frame = sweeps.run_sweep(config, str(tmp_path / "w"), threads=1, quiet=True,
+                             weights=weights)
+    assert [ids[0] for ids in started] == [3, 1, 2, 0]
+    plain = sweeps.run_sweep(config, str(tmp_path / "p"), threads=1, quiet=True,
+                             weights={i: 1.0 for i in range(4)})
+    columns = [c for c in frame.columns if c != "wall_s"]
+    pd.testing.assert_frame_equal(frame[columns], plain[columns], check_exact=True)
