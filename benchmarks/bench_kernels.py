@@ -21,11 +21,12 @@ zero-padded to n: a loop in mid-transient), best of three timed loops each:
 REV (``git archive`` of ``loopsim/`` into a temporary directory, imported as a second
 package, ``loopsim_baseline``) in the same process on the same inputs: ``--rounds``
 rounds, each one timed loop of the current and one of the baseline right-hand side
-in turn; it prints the medians, their ratio and max |u − u_base| / max |u_base|.  The
+in turn; it prints the medians, their ratio, the ratio of the fastest rounds (``min``:
+the least disturbed by other work on the machine) and max |u − u_base| / max |u_base|.  The
 baseline compiles its kernels into its own cache the first time (a minute or two).
 
 ``--parts`` splits the fast right-hand side into its kernels, each timed in its
-own loop on the same shape (median of ``--rounds`` rounds, the loops in turn): the
+own loop on the same shape (fastest of ``--rounds`` rounds, the loops in turn): the
 shape on the grid, Bᵀ
 (``tension_operator``), S0ᵀBᵀ and S0ᵀB₂ᵀ (``tension_columns``), the one
 (K, M) @ (M, M) product, the rest of the affine map T -> ε (its T = 0 part), the
@@ -104,13 +105,13 @@ PARTS = ("shape", "B", "columns", "BY", "affine", "gram", "cholesky", "velocity"
 
 
 def parts(problem, y, dydt, repeats, rounds):
-    """Median µs per call of the right-hand side and of each of its parts (PARTS), all timed
-    in turn, ``rounds`` times."""
+    """µs per call of the right-hand side and of each of its parts (PARTS): the fastest of
+    ``rounds`` rounds, all loops timed in turn in each."""
     x = y.reshape((3, -1))
     args = (x, problem.g0, problem.w, problem.ops, problem.ws)
     loops = [(_rhs, (problem, y, dydt))] + [(_part, args + (which,)) for which in range(7)]
-    total, shape, operator, columns, product, length_rate, gram, solve = interleaved(
-        loops, repeats, rounds)
+    total, shape, operator, columns, product, length_rate, gram, solve = (
+        min(times) for times in interleaved(loops, repeats, rounds))
     return dict(rhs=total, shape=shape, B=operator, columns=columns, BY=product,
                 affine=length_rate - operator - columns - product, gram=gram,
                 cholesky=solve - gram, velocity=total - shape - length_rate - solve)
@@ -140,7 +141,8 @@ def loop_of(function):
 
 
 def interleaved(loops, repeats, rounds):
-    """Median µs per call of each (fn, args) in ``loops``, timed in turn, ``rounds`` times."""
+    """µs per call of each (fn, args) in ``loops``, one list per loop: ``rounds`` rounds,
+    each timing every loop in turn."""
     for fn, args in loops:
         fn(*args, 1)
     times = [[] for _ in loops]
@@ -149,7 +151,7 @@ def interleaved(loops, repeats, rounds):
             start = time.perf_counter()
             fn(*args, repeats)
             timing.append(1e6 * (time.perf_counter() - start) / repeats)
-    return [float(np.median(timing)) for timing in times]
+    return times
 
 
 def main():
@@ -157,7 +159,7 @@ def main():
     parser.add_argument("--orders", default="6,8,12,16,24,32,48,64")
     parser.add_argument("--out")
     parser.add_argument("--baseline", metavar="REV")
-    parser.add_argument("--rounds", type=int, default=15)
+    parser.add_argument("--rounds", type=int, default=21)
     parser.add_argument("--parts", action="store_true")
     parser.add_argument("--rhs-only", action="store_true")
     args = parser.parse_args()
@@ -175,7 +177,8 @@ def main():
     if not args.rhs_only:
         header += f" {'blocks_us':>10} {'ratio':>6} {'jac_us':>9} {'lu_us':>8} {'max_du':>8}"
     if base is not None:
-        header += f" {'base_us':>8} {'new/base':>8} {'max_du_base':>11}"
+        header += (f" {'med_us':>8} {'base_us':>8} {'new/base':>8} {'min':>8}"
+                   f" {'max_du_base':>11}")
     if args.parts:
         header += "".join(f" {name:>8}" for name in PARTS)
     print(header)
@@ -210,16 +213,19 @@ def main():
             u_base = np.empty_like(x)
             base_models.evaluate(base_problem, x.reshape(-1), u_base.reshape(-1),
                                  np.empty(x.shape[1]))
-            new_us, base_us = interleaved(
+            new_times, base_times = interleaved(
                 [(_rhs, (problem, x.reshape(-1), u.reshape(-1))),
                  (base_rhs, (base_problem, x.reshape(-1), u_base.reshape(-1)))],
                 max(5, repeats // 4), args.rounds)
+            new_us, base_us = float(np.median(new_times)), float(np.median(base_times))
             models.evaluate(problem, x.reshape(-1), u.reshape(-1), np.empty(x.shape[1]))
             base_models.evaluate(base_problem, x.reshape(-1), u_base.reshape(-1),
                                  np.empty(x.shape[1]))
             row.update(rhs_median_us=new_us, base_median_us=base_us,
+                       min_ratio=min(new_times) / min(base_times),
                        max_du_base=float(np.abs(u - u_base).max() / np.abs(u_base).max()))
-            line += f" {base_us:>8.1f} {new_us / base_us:>8.2f} {row['max_du_base']:>11.1e}"
+            line += (f" {new_us:>8.1f} {base_us:>8.1f} {new_us / base_us:>8.2f}"
+                     f" {row['min_ratio']:>8.2f} {row['max_du_base']:>11.1e}")
         if args.parts:
             row["parts_us"] = parts(problem, x.reshape(-1), u.reshape(-1), max(5, repeats // 4),
                                     args.rounds)
