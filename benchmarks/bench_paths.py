@@ -2,6 +2,7 @@
 
 Usage: python benchmarks/bench_paths.py [--cases 100:60,150:45,150:80] [--orders 16,24,32]
                                      [--t-end 10] [--rtol 1e-6] [--repeats 2] [--out FILE.json]
+                                     [--baseline REV]
 
 Both paths integrate the same start (``shapes.initial_shape``, perturbation 1e-3,
 seed 0) with radau5 and the same exact Jacobian; only the RHS differs:
@@ -10,19 +11,26 @@ semi-normal equations) against ``loop_velocity_blocks`` (column blocks through
 two (M, M) projections and Householder QR: the code before this change),
 registered here as a second model type.  The two are run alternately,
 ``--repeats`` times each, best wall time kept, so both see the same machine
-load.  Prints wall times, the speed-up, the work counts (equal when both
+load.  Prints wall times (best of the repeats), the speed-up (of the best and of
+the medians), the work counts (equal when both
 paths take the same steps) and the terminal difference.
+
+``--baseline REV`` compares against the package as of git revision REV instead of the
+dense path (``bench_kernels.import_baseline``: its own model, Jacobian and driver, in
+the same process); the rows then also carry both terminal tilts
+(``diagnostics.tilt_deg``) and their difference.
 """
 import argparse
 import collections
+import importlib
 import json
 import time
 
 import numpy as np
 
 import loopsim
-from loopsim import integrators, shapes
-from loopsim.integrators.driver import integrate
+from bench_kernels import import_baseline
+from loopsim import diagnostics, shapes
 from loopsim.models import (auxiliary, implements, jacobian, local_sbt, monitored_errors, rhs,
                             steady_invariants)
 
@@ -63,11 +71,16 @@ def _dense_multiplier(problem, out):
     out[:] = problem.ws.tension
 
 
-def run(problem, x0, t_end, options):
+def run(problem, x0, t_end, rtol, package=loopsim):
+    """radau5 from x0 to t_end at rtol (atol = rtol / 1000) with ``package``'s driver:
+    (wall s, status, x, counts)."""
+    driver = importlib.import_module(package.__name__ + ".integrators.driver")
+    methods = importlib.import_module(package.__name__ + ".integrators")
+    radau5, options = methods.RADAU5, methods.step_options(rtol, rtol * 1e-3)
     y_out = np.empty((1, x0.size))
     start = time.perf_counter()
-    status, t, y, counts, _ = integrate(integrators.RADAU5, problem, x0.ravel().copy(), 0.0,
-                                        t_end, np.array([t_end]), options, y_out)
+    status, t, y, counts, _ = driver.integrate(radau5, problem, x0.ravel().copy(), 0.0, t_end,
+                                               np.array([t_end]), options, y_out)
     return time.perf_counter() - start, int(status), y.reshape(x0.shape), counts
 
 
@@ -79,40 +92,55 @@ def main():
     parser.add_argument("--rtol", type=float, default=1e-6)
     parser.add_argument("--repeats", type=int, default=2)
     parser.add_argument("--out")
+    parser.add_argument("--baseline", metavar="REV")
     args = parser.parse_args()
-    options = integrators.step_options(args.rtol, args.rtol * 1e-3)
     w = loopsim.config.DEFAULT_W
+    # the comparator: (make_problem(g0, n), package), the dense path by default
+    other = (lambda g0, n: DenseLoopProblem(g0, w, local_sbt.make_operators(n),
+                                            local_sbt.make_workspace(n)), loopsim)
+    if args.baseline:
+        base = import_baseline(args.baseline)
+        from loopsim_baseline.models import local_sbt as base_sbt
+
+        other = (lambda g0, n: base_sbt.LoopProblem(g0, w, base_sbt.make_operators(n),
+                                                    base_sbt.make_workspace(n)), base)
+    fast = (lambda g0, n: local_sbt.LoopProblem(g0, w, local_sbt.make_operators(n),
+                                                local_sbt.make_workspace(n)), loopsim)
     warm = shapes.initial_shape(4, np.radians(30.0), 1e-3, 0)
-    for make in (local_sbt.LoopProblem, DenseLoopProblem):  # compile outside the timing
-        run(make(60.0, w, local_sbt.make_operators(4), local_sbt.make_workspace(4)), warm, 0.01,
-            options)
+    for make, package in (fast, other):  # compile outside the timing
+        run(make(60.0, 4), warm, 0.01, args.rtol, package)
     rows = []
-    print(f"{'g0':>5} {'th0':>4} {'n':>3} {'dense_s':>8} {'fast_s':>8} {'speedup':>7} "
-          f"{'nfev':>7} {'njev':>5} {'nlu':>5} {'steps':>6} {'max|dx|':>8}")
+    print(f"{'g0':>5} {'th0':>4} {'n':>3} {'dense_s':>8} {'fast_s':>8} {'speedup':>7} {'median':>7} "
+          f"{'nfev':>7} {'njev':>5} {'nlu':>5} {'steps':>6} {'max|dx|':>8} {'|dtilt|':>9}")
     for case in args.cases.split(","):
         g0, theta0 = (float(v) for v in case.split(":"))
         for n in (int(v) for v in args.orders.split(",")):
             x0 = shapes.initial_shape(n, np.radians(theta0), 1e-3, 0)
-            ops = local_sbt.make_operators(n)
-            best = {"dense": np.inf, "fast": np.inf}
+            walls = {"dense": [], "fast": []}
             result = {}
             for _ in range(args.repeats):
-                for name, make in (("dense", DenseLoopProblem), ("fast", local_sbt.LoopProblem)):
-                    wall, status, x, counts = run(make(g0, w, ops, local_sbt.make_workspace(n)),
-                                                  x0, args.t_end, options)
-                    best[name] = min(best[name], wall)
+                for name, (make, package) in (("dense", other), ("fast", fast)):
+                    wall, status, x, counts = run(make(g0, n), x0, args.t_end, args.rtol,
+                                                  package)
+                    walls[name].append(wall)
                     result[name] = (status, x, counts)
+            best = {name: min(times) for name, times in walls.items()}
             counts = result["fast"][2]
             row = dict(g0=g0, theta0=theta0, n=n, dense_s=best["dense"], fast_s=best["fast"],
-                       speedup=best["dense"] / best["fast"],
+                       speedup=best["dense"] / best["fast"], walls_dense=walls["dense"],
+                       walls_fast=walls["fast"],
+                       median_speedup=float(np.median(walls["dense"]) / np.median(walls["fast"])),
                        counts_fast=[int(c) for c in counts],
                        counts_dense=[int(c) for c in result["dense"][2]],
                        max_dx=float(np.abs(result["fast"][1] - result["dense"][1]).max()),
-                       status=[result["fast"][0], result["dense"][0]])
+                       status=[result["fast"][0], result["dense"][0]],
+                       tilt_fast_deg=diagnostics.tilt_deg(result["fast"][1]),
+                       tilt_dense_deg=diagnostics.tilt_deg(result["dense"][1]))
             rows.append(row)
             print(f"{g0:>5g} {theta0:>4g} {n:>3} {row['dense_s']:>8.2f} {row['fast_s']:>8.2f} "
-                  f"{row['speedup']:>7.2f} {counts[2]:>7} {counts[3]:>5} {counts[4]:>5} "
-                  f"{counts[0] + counts[1]:>6} {row['max_dx']:>8.1e}", flush=True)
+                  f"{row['speedup']:>7.2f} {row['median_speedup']:>7.2f} {counts[2]:>7} {counts[3]:>5} {counts[4]:>5} "
+                  f"{counts[0] + counts[1]:>6} {row['max_dx']:>8.1e} "
+                  f"{abs(row['tilt_fast_deg'] - row['tilt_dense_deg']):>9.1e}", flush=True)
     if args.out:
         with open(args.out, "w") as handle:
             json.dump(rows, handle, indent=1)

@@ -1,4 +1,5 @@
-"""Dense linear algebra in Numba: LAPACK's LU (implicit integrators) and QR (tension solve).
+"""Dense linear algebra in Numba: LAPACK's LU (implicit integrators), QR and Cholesky
+(tension solve), and BLAS's matrix product by blocks.
 
 The factorisations, the O(n³) parts, are scipy's LAPACK getrf and geqrf,
 reached through the ``numba_xxgetrf`` and ``numba_ez_geqrf`` wrappers that
@@ -15,11 +16,18 @@ triangle with the diagonal and Lᵀ the strict upper triangle (unit diagonal);
 Uᵀ z = b (forward), Lᵀ w = z (backward), x = Pᵀ w (the swaps in reverse).
 :func:`least_squares_affine` takes its block already column-major: row j of
 the row-major buffer is column j of the matrix.
+
+Products.  :func:`add_product` and :func:`gram_upper` call BLAS's gemm through
+``numba_xxgemm`` (``np.dot`` calls it too) by blocks of rows: at the tension solve's
+sizes (K = 2n + 1 ≤ 65 rows, M = 4n + 1 columns) scipy's OpenBLAS then takes its
+small-matrix kernels, and the Gram matrix costs only its upper triangle
+(docs/performance.md, "Fewer products for the tension").
 """
 import numba
 import numpy as np
 from numba import types
-from numba.extending import overload
+from numba.core import cgutils
+from numba.extending import intrinsic, overload
 from numba.np.linalg import F_INT_nbtype, F_INT_nptype, ensure_lapack
 
 from .config import JIT
@@ -44,7 +52,7 @@ _GEQRF = types.ExternalFunction("numba_ez_geqrf", types.intc(
     types.char, types.intp, types.intp, types.CPointer(types.float64), types.intp,
     types.CPointer(types.float64)))
 _REAL = ord("d")
-_UPPER = ord("U")
+_LOWER = ord("L")
 
 
 def lu_factor(a, piv):
@@ -133,37 +141,119 @@ _POTRF = types.ExternalFunction("numba_xxpotrf", types.intc(
     types.char, types.char, types.intp, types.CPointer(types.float64), types.intp))
 
 
+#: numba_xxgemm(kind, transa, transb, m, n, k, alpha, a, lda, b, ldb, beta, c, ldc): BLAS's
+#: column-major C = alpha op(A) op(B) + beta C (Numba's helper library), real only.
+_GEMM = types.ExternalFunction("numba_xxgemm", types.intc(
+    types.char, types.char, types.char, types.intp, types.intp, types.intp,
+    types.CPointer(types.float64), types.CPointer(types.float64), types.intp,
+    types.CPointer(types.float64), types.intp, types.CPointer(types.float64),
+    types.CPointer(types.float64), types.intp))
+_NO = ord("n")
+_TRANSPOSED = ord("t")
+#: Rows per block of :func:`add_product` and :func:`gram_upper` (measured: module doc).
+PRODUCT_ROWS = 32
+GRAM_ROWS = 24
+
+
+@intrinsic
+def _by_reference(typingctx, value):
+    """A pointer to a copy of the float64 ``value`` on the caller's stack (BLAS takes its
+    scalars by reference)."""
+    if value != types.float64:
+        return None
+
+    def codegen(context, builder, signature, args):
+        return cgutils.alloca_once_value(builder, args[0])
+    return types.CPointer(types.float64)(types.float64), codegen
+
+
+@kernel
+def add_product(left, right, out):
+    """out += left @ right for C-contiguous left (R, N), right (N, C), out (R, C):
+    BLAS's gemm with beta = 1 on blocks of at most :data:`PRODUCT_ROWS` rows of left and out.
+
+    Row-major x is column-major xᵀ, so each block is outᵀ += rightᵀ leftᵀ: gemm "N", "N".
+    """
+    rows, inner = left.shape
+    columns = right.shape[1]
+    one = _by_reference(1.0)
+    blocks = (rows + PRODUCT_ROWS - 1) // PRODUCT_ROWS
+    for q in range(blocks):
+        first = (q * rows) // blocks
+        count = ((q + 1) * rows) // blocks - first
+        _GEMM(_REAL, _NO, _NO, columns, count, inner, one, right.ctypes, columns,
+              left[first:].ctypes, inner, one, out[first:].ctypes, columns)
+
+
+@kernel
+def gram_upper(a_t, gram):
+    """The upper triangle (diagonal included) of gram = a_t a_tᵀ, a_t (K, M) C-contiguous,
+    by blocks of at most :data:`GRAM_ROWS` rows: for row blocks I ≤ J, gram[I, J] = a_I a_Jᵀ,
+    whose column-major form is a_J a_Iᵀ, gemm "T", "N".  The strict lower triangle is
+    not written."""
+    k, m = a_t.shape
+    one = _by_reference(1.0)
+    zero = _by_reference(0.0)
+    blocks = (k + GRAM_ROWS - 1) // GRAM_ROWS
+    for p in range(blocks):
+        first_i = (p * k) // blocks
+        count_i = ((p + 1) * k) // blocks - first_i
+        for q in range(p, blocks):
+            first_j = (q * k) // blocks
+            count_j = ((q + 1) * k) // blocks - first_j
+            _GEMM(_REAL, _TRANSPOSED, _NO, count_j, count_i, m, one, a_t[first_j:].ctypes, m,
+                  a_t[first_i:].ctypes, m, zero, gram[first_i, first_j:].ctypes, k)
+
+
 @kernel
 def _cholesky_solve(factor, rhs):
-    """Solve L Lᵀ y = rhs in place, L the row-major lower triangle of ``factor``."""
+    """Solve L Lᵀ y = rhs in place, Lᵀ the row-major upper triangle of ``factor`` (row j
+    holds column j of L from the diagonal on).
+
+    L z = rhs column by column (z_j = rhs_j / L_jj, then rhs_i −= L_ij z_j along row j: a
+    loop without a chain of dependent additions, which vectorises), then Lᵀ y = z row by
+    row, each dot product in four partial sums (one chain of dependent additions runs at a
+    quarter of the speed)."""
     k = rhs.shape[0]
-    for i in range(k):
-        acc = rhs[i]
-        for j in range(i):
-            acc -= factor[i, j] * rhs[j]
-        rhs[i] = acc / factor[i, i]
+    for j in range(k):
+        row = factor[j]
+        z = rhs[j] / row[j]
+        rhs[j] = z
+        for i in range(j + 1, k):
+            rhs[i] -= row[i] * z
     for i in range(k - 1, -1, -1):
-        acc = rhs[i]
-        for j in range(i + 1, k):
-            acc -= factor[j, i] * rhs[j]
-        rhs[i] = acc / factor[i, i]
+        row = factor[i]
+        s0 = 0.0
+        s1 = 0.0
+        s2 = 0.0
+        s3 = 0.0
+        j = i + 1
+        while j + 3 < k:
+            s0 += row[j] * rhs[j]
+            s1 += row[j + 1] * rhs[j + 1]
+            s2 += row[j + 2] * rhs[j + 2]
+            s3 += row[j + 3] * rhs[j + 3]
+            j += 4
+        while j < k:
+            s0 += row[j] * rhs[j]
+            j += 1
+        rhs[i] = (rhs[i] - ((s0 + s1) + (s2 + s3))) / row[i]
 
 
 @kernel
 def _scaled_normal_residual(block, scale, tau, residual, out):
     """out = −D Aᵀ (A τ + b): the normal equations' residual in the scaled unknowns
-    (``residual`` (M,) scratch: A τ + b)."""
+    (``residual`` (M,) scratch: A τ + b); both products are BLAS's gemv."""
     k = block.shape[0] - 1
     m = block.shape[1]
-    copy_into(residual, block[k])
+    a_t = block[:k]
+    b = block[k]
+    np.dot(tau, a_t, residual)
+    for p in range(m):
+        residual[p] += b[p]
+    np.dot(a_t, residual, out)
     for j in range(k):
-        for p in range(m):
-            residual[p] += block[j, p] * tau[j]
-    for j in range(k):
-        acc = 0.0
-        for p in range(m):
-            acc += block[j, p] * residual[p]
-        out[j] = -scale[j] * acc
+        out[j] *= -scale[j]
 
 
 @kernel
@@ -173,8 +263,9 @@ def least_squares_normal(block, scale, out, gram, residual, correction):
 
         (D Aᵀ A D) y = −D Aᵀ b,   τ = D y,   D = diag(scale),
 
-    by LAPACK's Cholesky (potrf, in ``gram`` (K, K); ``residual`` (M,) and ``correction``
-    (K,) are scratch), then one refinement step with
+    by LAPACK's Cholesky (potrf, in the upper triangle of ``gram`` (K, K), filled by
+    :func:`gram_upper`; ``residual`` (M,) and ``correction`` (K,) are scratch), then one
+    refinement step with
     the residual −D Aᵀ(A τ + b) of the normal equations.  The step restores QR's
     accuracy while cond(A D) ≪ 1/√eps (``models.local_sbt``: cond(A D) ≈ 20 on run
     shapes, 2·10³ on a strongly stretched one).  Returns potrf's info: 0, or k > 0
@@ -182,20 +273,23 @@ def least_squares_normal(block, scale, out, gram, residual, correction):
     solution; the caller falls back to QR).
     """
     k = block.shape[0] - 1
-    a_t = block[:k]
-    np.dot(a_t, a_t.T, gram)
+    gram_upper(block[:k], gram)
     for i in range(k):
-        for j in range(k):
+        for j in range(i, k):
             gram[i, j] *= scale[i] * scale[j]
-    # Row-major gram is LAPACK's column-major gramᵀ = gram; uplo "U" there leaves
-    # gram = L Lᵀ with L in the row-major lower triangle.
-    info = _POTRF(_REAL, _UPPER, k, gram.ctypes, k)
+    # Row-major gram is LAPACK's column-major gramᵀ = gram; uplo "L" there leaves
+    # gram = L Lᵀ with Lᵀ in the row-major upper triangle.
+    info = _POTRF(_REAL, _LOWER, k, gram.ctypes, k)
     if info != 0:
         return info
-    out[:] = 0.0
-    for _ in range(2):  # the solve, then one refinement step
-        _scaled_normal_residual(block, scale, out, residual, correction)
-        _cholesky_solve(gram, correction)
-        for i in range(k):
-            out[i] += scale[i] * correction[i]
+    np.dot(block[:k], block[k], correction)  # the solve: −D Aᵀ b, the residual at τ = 0
+    for i in range(k):
+        correction[i] *= -scale[i]
+    _cholesky_solve(gram, correction)
+    for i in range(k):
+        out[i] = scale[i] * correction[i]
+    _scaled_normal_residual(block, scale, out, residual, correction)  # one refinement step
+    _cholesky_solve(gram, correction)
+    for i in range(k):
+        out[i] += scale[i] * correction[i]
     return 0

@@ -16,7 +16,8 @@ from .loop_jacobian import loop_jacobian
 from .loop_maps import (  # noqa: F401 - re-exported
     LoopOperators, Workspace, compose_maps, force_map, grid_size, length_creation,
     length_creation_map, length_rate_operator, loop_velocity, loop_velocity_blocks,
-    make_operators, make_workspace, shape_on_grid, tension_operator, velocity_map,
+    make_operators, make_workspace, shape_on_grid, tension_columns, tension_operator,
+    velocity_map,
 )
 from .loop_shape import (  # noqa: F401 - re-exported
     energy_sums, relative_length_error, shape_invariants, spectral_tail, top_mode_share,

@@ -27,9 +27,11 @@ On that grid the maps compose into one operator on the tension's grid values
     ε(T) = (B₂ + B B) T + b,   B = P1 ∘ G,  B₂ = P2 ∘ G,  G_il = x'(s_i)·x'(s_l),
 
 with P1 = S1 F and P2 = S2 F the projected first and second derivatives and ∘
-the elementwise product.  A = (B₂ + B B) S0 costs three (K, M) @ (M, M)
-products instead of two (M, M) @ (M, 3K + 3) ones, half the flops; measured
-1.4–2× faster per call at n = 16–64 (``benchmarks/bench_kernels.py``).  The
+the elementwise product.  A = (B₂ + B B) S0 costs one (K, M) @ (M, M) product,
+B (B S0): B S0 and B₂ S0 take O(n M) operations (:func:`tension_columns`: the
+product of the tangent with one basis function loses, on projection, only the modes
+above n, which come from the tangent's top modes), where forming them took two
+more such products (docs/performance.md, "Fewer products for the tension").  The
 column-block form (:func:`compose_maps`, :func:`loop_velocity_blocks`) stays
 for the Jacobian and as the reference the fast path is tested against.
 """
@@ -40,11 +42,11 @@ import numpy as np
 
 from .. import spectral
 from ..jit import entry, kernel
-from ..linalg import least_squares_affine, least_squares_normal
+from ..linalg import add_product, copy_into, least_squares_affine, least_squares_normal
 
 #: the map T -> ε (leading order 2 T'') for the normal-equations solve.
 LoopOperators = collections.namedtuple(
-    "LoopOperators", "n m S0 S1 S2 S4 F P P1 S1T S2T S4T FT S0T P1T P2T column_scale"
+    "LoopOperators", "n m S0 S1 S2 S4 F P P1 S1T FT S0T P1T column_scale"
 )
 
 #: Per-case scratch arrays, so the right-hand side never allocates.  Column
@@ -53,14 +55,18 @@ LoopOperators = collections.namedtuple(
 #: ``length_rate`` (K+1, M) is the affine map T -> ε stored column by column (row j:
 #: the column of T = φ_j; row K: the affine part), as LAPACK's QR wants it; ``tau``
 #: is the QR's scratch.
-#: The fast path's scratch: ``coupling`` (2M, M) holds Bᵀ over B₂ᵀ (tension_operator),
-#: ``partial`` and ``columns`` (K, M) are S0ᵀ Bᵀ and S0ᵀ Bᵀ Bᵀ, ``fields`` (3, 3, M) and
+#: The fast path's scratch: ``coupling`` (M, M) holds Bᵀ (tension_operator),
+#: ``partial`` (K, M) is S0ᵀ Bᵀ, ``fields`` (3, 3, M) and
 #: ``grid_force`` (3, M) grid fields, ``tension_grid`` (M,), and ``gram`` (K, K),
-#: ``residual`` (M,), ``correction`` (K,) the normal equations' (linalg.least_squares_normal).
+#: ``residual`` (M,), ``correction`` (K,) the normal equations' (linalg.least_squares_normal);
+#: ``shape_modes`` (4, 3, K) the coefficients of x', x'', x''', x'''' and ``shape_grid``
+#: (4, 3, M) their grid values (shape_on_grid; ``tangent``, ``curvature``, ``x3`` and
+#: ``x4`` are its rows), ``mode_sums`` (8, M) the running sums of :func:`tension_columns`.
 Workspace = collections.namedtuple(
     "Workspace",
     "tangent curvature x4 raw force mobile dmobile length_rate velocity tension tau "
-    "coupling partial columns fields grid_force tension_grid gram residual correction"
+    "coupling partial fields grid_force tension_grid gram residual correction "
+    "x3 shape_modes shape_grid mode_sums"
 )
 
 
@@ -79,8 +85,8 @@ def make_operators(n):
     c = np.ascontiguousarray
     return LoopOperators(
         n, m, c(S[0]), c(S[1]), c(S[2]), c(S[3]), c(F), c(S[0] @ F), c(S[1] @ F),
-        c(S[1].T), c(S[2].T), c(S[3].T), c(F.T), c(S[0].T), c((S[1] @ F).T),
-        c((S[2] @ F).T), 1.0 / (1.0 + 2.0 * spectral.wavenumbers(n) ** 2),
+        c(S[1].T), c(F.T), c(S[0].T), c((S[1] @ F).T),
+        1.0 / (1.0 + 2.0 * spectral.wavenumbers(n) ** 2),
     )
 
 
@@ -88,22 +94,36 @@ def make_operators(n):
 def make_workspace(n):
     m = 4 * n + 1
     k = 2 * n + 1
+    grid = np.empty((4, 3, m))
     return Workspace(
-        np.empty((3, m)), np.empty((3, m)), np.empty((3, m)),
+        grid[0], grid[1], grid[3],
         np.empty((m, 3, k + 1)), np.empty((m, 3, k + 1)), np.empty((m, 3, k + 1)),
         np.empty((m, 3, k + 1)), np.empty((k + 1, m)), np.empty((3, m)), np.empty(k),
-        np.empty(k), np.empty((2 * m, m)), np.empty((k, m)), np.empty((k, m)),
-        np.empty((3, 3, m)), np.empty((3, m)), np.empty(m), np.empty((k, k)), np.empty(m),
-        np.empty(k),
+        np.empty(k), np.empty((m, m)), np.empty((k, m)), np.empty((3, 3, m)),
+        np.empty((3, m)), np.empty(m), np.empty((k, k)), np.empty(m), np.empty(k),
+        grid[2], np.empty((4, 3, k)), grid, np.empty((8, m)),
     )
 
 
 @kernel
 def shape_on_grid(x, ops, ws):
-    """Grid values of x', x'' and x'''' from coefficients x (3, K)."""
-    np.dot(x, ops.S1T, ws.tangent)
-    np.dot(x, ops.S2T, ws.curvature)
-    np.dot(x, ops.S4T, ws.x4)
+    """Coefficients of x', x'', x''', x'''' from coefficients x (3, K), into ws.shape_modes,
+    and their grid values, into ws.shape_grid (ws.tangent, ws.curvature, ws.x3, ws.x4):
+    one (12, K) @ (K, M) product.  Per mode k, (a cos ks + b sin ks)' =
+    k b cos ks − k a sin ks."""
+    n, m, k = ops.n, ops.m, x.shape[1]
+    modes = ws.shape_modes
+    for p in range(4):
+        for c in range(3):
+            modes[p, c, 0] = 0.0
+    for c in range(3):
+        for mode in range(1, n + 1):
+            a, b = x[c, mode], x[c, n + mode]
+            for p in range(4):
+                a, b = mode * b, -mode * a
+                modes[p, c, mode] = a
+                modes[p, c, n + mode] = b
+    np.dot(modes.reshape((12, k)), ops.S0T, ws.shape_grid.reshape((12, m)))
 
 
 @kernel
@@ -161,7 +181,7 @@ def compose_maps(x, g0, w, ops, ws):
 
 @kernel
 def tension_operator(ops, ws):
-    """Bᵀ and B₂ᵀ into ws.coupling: B = P1 ∘ G, B₂ = P2 ∘ G, G_il = t_i·t_l (t = x' on the grid).
+    """Bᵀ into ws.coupling: B = P1 ∘ G, G_il = t_i·t_l (t = x' on the grid).
 
     With T the tension's grid values, f_c = P1(t_c T) − x⁗_c − g0 δ_cz (the
     projected force: (T x')' has order 2n, so P_n of it is P1 applied to T x'),
@@ -169,18 +189,99 @@ def tension_operator(ops, ws):
 
         ε = Σ_c t_c P1 m_c − w(1 − |t|²)
           = Σ_c t_c P2 (t_c T) + Σ_c t_c P1 (t_c h) + (the T = 0 part)
-          = B₂ T + B (B T) + b,
+          = B₂ T + B (B T) + b,   B₂ = P2 ∘ G,
 
     because P1 P1 = S1 (F S1) F = S1 D F = P2 and Σ_c t_c P (t_c v) = (P ∘ G) v.
+    Only the product B (B S0) needs B itself: B S0 and B₂ S0 come from
+    :func:`tension_columns`.
     """
     m = ops.m
     t = ws.tangent
     coupling = ws.coupling
     for l in range(m):
+        row, p1 = coupling[l], ops.P1T[l]
+        t0, t1, t2 = t[0, l], t[1, l], t[2, l]
         for i in range(m):
-            g = t[0, i] * t[0, l] + t[1, i] * t[1, l] + t[2, i] * t[2, l]
-            coupling[l, i] = ops.P1T[l, i] * g
-            coupling[m + l, i] = ops.P2T[l, i] * g
+            row[i] = p1[i] * (t[0, i] * t0 + t[1, i] * t1 + t[2, i] * t2)
+
+
+@kernel
+def tension_columns(ops, ws):
+    """(B S0)ᵀ into ws.partial and (B₂ S0)ᵀ into ws.length_rate[:K] (B, B₂:
+    :func:`tension_operator`), in O(n M) operations instead of two (K, M) @ (M, M) products.
+
+    Column j of S0 is cos js or sin js, the real and imaginary parts of φ_j = e^{ijs}.
+    With t_c = Σ_k (α_ck e^{iks} + c.c.)/2 + const, α_ck = â_ck − i b̂_ck the tangent's
+    cos and sin coefficients of mode k, t_c φ_j has order n + j and its modes above n
+    come only from t_c's modes k > n − j:
+
+        P_n[t_c φ_j] = t_c φ_j − ½ Σ_{k > n−j} α_ck e^{i(k+j)s}.
+
+    Differentiating once (P1) or twice (P2), multiplying by t_c and summing over c, with
+    q_k = Σ_c t_c α_ck and the running sums H_p = ½ Σ_{k > n−j} (ik)^p q_k e^{iks}:
+
+        (B φ_j)  = e^{ijs} (A1 + ij A0),
+        (B₂ φ_j) = e^{ijs} (A2 + 2ij A1 − j² A0),   A_p = t·t^{(p)} − H_p
+
+    (t^{(p)} the p-th derivative of t = x'; t·t⁽⁰⁾ = |t|²).  Each column j adds one mode
+    k = n − j + 1 to the sums.  ws.mode_sums holds Re, Im of A0, A1, A2 and of
+    ψ = ½ q_k e^{iks}; the loops over the grid write at most two arrays each, so that
+    they vectorise.  Needs :func:`shape_on_grid`'s fields.
+    """
+    m, k = ops.m, ops.S0.shape[1]
+    n = ops.n
+    t, t1, t2, modes = ws.tangent, ws.curvature, ws.x3, ws.shape_modes[0]
+    sums = ws.mode_sums
+    r0, i0, r1, i1, r2, i2, pr, pi = (sums[0], sums[1], sums[2], sums[3], sums[4], sums[5],
+                                      sums[6], sums[7])
+    y_t, e_t = ws.partial, ws.length_rate
+    for i in range(m):
+        r0[i] = t[0, i] * t[0, i] + t[1, i] * t[1, i] + t[2, i] * t[2, i]
+        r1[i] = t[0, i] * t1[0, i] + t[1, i] * t1[1, i] + t[2, i] * t1[2, i]
+        r2[i] = t[0, i] * t2[0, i] + t[1, i] * t2[1, i] + t[2, i] * t2[2, i]
+    for i in range(m):
+        i0[i] = 0.0
+        i1[i] = 0.0
+        i2[i] = 0.0
+    copy_into(y_t[0], r1)
+    copy_into(e_t[0], r2)
+    for j in range(1, n + 1):
+        mode = n + 1 - j
+        wave = float(mode)
+        ar0, ai0 = 0.5 * modes[0, mode], -0.5 * modes[0, n + mode]  # ½ α_ck
+        ar1, ai1 = 0.5 * modes[1, mode], -0.5 * modes[1, n + mode]
+        ar2, ai2 = 0.5 * modes[2, mode], -0.5 * modes[2, n + mode]
+        cos_k, sin_k = ops.S0T[mode], ops.S0T[n + mode]
+        for i in range(m):
+            qr = t[0, i] * ar0 + t[1, i] * ar1 + t[2, i] * ar2
+            qi = t[0, i] * ai0 + t[1, i] * ai1 + t[2, i] * ai2
+            pr[i] = qr * cos_k[i] - qi * sin_k[i]
+            pi[i] = qr * sin_k[i] + qi * cos_k[i]
+        wave2 = wave * wave
+        for i in range(m):
+            r0[i] -= pr[i]
+            i0[i] -= pi[i]
+        for i in range(m):
+            r1[i] += wave * pi[i]
+            i1[i] -= wave * pr[i]
+        for i in range(m):
+            r2[i] += wave2 * pr[i]
+            i2[i] += wave2 * pi[i]
+        fj = float(j)
+        fj2 = fj * fj
+        cos_j, sin_j = ops.S0T[j], ops.S0T[n + j]
+        y_cos, y_sin = y_t[j], y_t[n + j]
+        for i in range(m):
+            zr = r1[i] - fj * i0[i]
+            zi = i1[i] + fj * r0[i]
+            y_cos[i] = cos_j[i] * zr - sin_j[i] * zi
+            y_sin[i] = sin_j[i] * zr + cos_j[i] * zi
+        e_cos, e_sin = e_t[j], e_t[n + j]
+        for i in range(m):
+            zr = r2[i] - 2.0 * fj * i1[i] - fj2 * r0[i]
+            zi = i2[i] + 2.0 * fj * r1[i] - fj2 * i0[i]
+            e_cos[i] = cos_j[i] * zr - sin_j[i] * zi
+            e_sin[i] = sin_j[i] * zr + cos_j[i] * zi
 
 
 @kernel
@@ -188,20 +289,14 @@ def length_rate_operator(g0, w, ops, ws):
     """The affine map T -> ε into ws.length_rate: rows 0..K-1 the columns of
     A = (B₂ + B B) S0 (stored Aᵀ = S0ᵀ B₂ᵀ + (S0ᵀ Bᵀ) Bᵀ), row K the T = 0 part b.
 
-    Needs ws.tangent and ws.x4 (:func:`shape_on_grid`); leaves Bᵀ, B₂ᵀ in ws.coupling
-    and the T = 0 force in ws.fields[0]; uses ws.fields[1:] as scratch.
+    Needs :func:`shape_on_grid`'s fields; leaves Bᵀ in ws.coupling, S0ᵀ Bᵀ in ws.partial
+    and the T = 0 force in ws.fields[0]; uses ws.fields[1:] as scratch.  One
+    (K, M) @ (M, M) product: S0ᵀ B₂ᵀ and S0ᵀ Bᵀ come from :func:`tension_columns`.
     """
     m, k = ops.m, ops.S0.shape[1]
     tension_operator(ops, ws)
-    b_t = ws.coupling[:m]
-    b2_t = ws.coupling[m:]
-    a_t = ws.length_rate[:k]
-    np.dot(ops.S0T, b_t, ws.partial)  # (B S0)ᵀ
-    np.dot(ops.S0T, b2_t, a_t)
-    np.dot(ws.partial, b_t, ws.columns)
-    for j in range(k):
-        for i in range(m):
-            a_t[j, i] += ws.columns[j, i]
+    tension_columns(ops, ws)
+    add_product(ws.partial, ws.coupling, ws.length_rate[:k])
     t, force, mobile = ws.tangent, ws.fields[0], ws.fields[1]
     for i in range(m):
         for c in range(3):
@@ -225,7 +320,8 @@ def loop_velocity(problem, y, dydt):
 
     u_c = F m_c, m_c = f_c + (t·f) t_c, f_c = P1(t_c T) − x⁗_c − g0 δ_cz, with T the
     least-squares tension of :func:`length_rate_operator`: the same map as
-    :func:`loop_velocity_blocks`, at about half the flops.
+    :func:`loop_velocity_blocks`, with one (K, M) @ (M, M) product where that builds two (M, M)
+    @ (M, 3K + 3) ones.
 
     Not decorated: it is compiled as the local model's ``rhs`` implementation
     (``local_sbt``), holding its code itself rather than calling a kernel that does, so
