@@ -91,22 +91,28 @@ def twin_tolerances(rtol, atol, tail_tol):
 
 #: The determinacy fields of a row, and their values when no twin ran.
 DETERMINACY_FIELDS = ("determined", "theta_uncertainty_deg", "aspect_uncertainty",
-                      "twin_nfev")
+                      "twin_nfev", "twin_regime", "twin_theta_final_deg", "twin_aspect_ratio")
 NO_TWIN = dict(determined=None, theta_uncertainty_deg=math.nan, aspect_uncertainty=math.nan,
-               twin_nfev=0)
+               twin_nfev=0, twin_regime=None, twin_theta_final_deg=math.nan,
+               twin_aspect_ratio=math.nan)
 
 
 def determinacy(run, twin, twin_nfev, thresholds=Thresholds()):
     """Determinacy fields from the run's and its twin's outcomes (dicts with
     ``regime``, ``theta_final_deg``, ``aspect_ratio``).  A failed run has no outcome: it
     is not determined, with no uncertainty to give (``determined`` is empty only where no
-    twin was asked for, so a column never mixes empty and False)."""
+    twin was asked for, so a column never mixes empty and False).  The twin's own outcome
+    is kept (``twin_regime``, ``twin_theta_final_deg``, ``twin_aspect_ratio``): over a
+    cell's seeds the twins are a sample at the stricter tolerances (``sweeps.seeds_auto``
+    checks distributions against them)."""
+    outcome = dict(twin_regime=twin["regime"], twin_theta_final_deg=float(
+        twin["theta_final_deg"]), twin_aspect_ratio=float(twin["aspect_ratio"]))
     if run["regime"] == "failed":
-        return dict(NO_TWIN, determined=False, twin_nfev=int(twin_nfev))
+        return dict(NO_TWIN, determined=False, twin_nfev=int(twin_nfev), **outcome)
     tilt = abs(run["theta_final_deg"] - twin["theta_final_deg"])
     aspect = abs(run["aspect_ratio"] - twin["aspect_ratio"])
     determined = (run["regime"] == twin["regime"] != "failed"
                   and tilt <= thresholds.determined_tilt_deg
                   and aspect <= thresholds.determined_aspect)  # False for NaN
     return dict(determined=bool(determined), theta_uncertainty_deg=float(tilt),
-                aspect_uncertainty=float(aspect), twin_nfev=int(twin_nfev))
+                aspect_uncertainty=float(aspect), twin_nfev=int(twin_nfev), **outcome)

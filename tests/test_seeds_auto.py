@@ -147,11 +147,17 @@ def test_seeds_auto_from_the_command_line(tmp_path, capsys):
 
 
 def _rows(regimes, determined, round_=0):
+    tilts = [10.0 + 7 * k for k in range(len(regimes))]
     return pd.DataFrame(dict(g0=150.0, theta0_deg=60.0, n=6, perturbation=0.01,
                              seed=range(len(regimes)), regime=regimes, determined=determined,
-                             theta_final_deg=[10.0 + 7 * k for k in range(len(regimes))],
-                             aspect_ratio=2.0, nfev=100, twin_nfev=[
-                                 0 if d is None else 300 for d in determined],
+                             theta_final_deg=tilts, aspect_ratio=2.0, nfev=100,
+                             twin_nfev=[0 if d is None else 300 for d in determined],
+                             twin_regime=[None if d is None else r
+                                          for d, r in zip(determined, regimes)],
+                             twin_theta_final_deg=[np.nan if d is None else t + (not d)
+                                                   for d, t in zip(determined, tilts)],
+                             twin_aspect_ratio=[np.nan if d is None else 2.0
+                                                for d in determined],
                              wall_s=1.0, round=round_))
 
 
@@ -163,9 +169,10 @@ def test_runs_are_samples_when_seeds_disagree_or_a_twin_does():
 
 
 def test_sampled_cells_drop_their_twins_and_are_checked_in_distribution():
-    """A cell whose runs are samples plans its next seeds without twins and its check from
-    the seeds that had none; a cell of determined trajectories keeps its twins; the
-    expected costs come from the cells' rows (twins counted where they run)."""
+    """A cell whose runs are samples plans its next seeds without twins; its stricter sample
+    is its twins' outcomes, topped up to check_seeds with runs of the seeds that had none;
+    a cell of determined trajectories keeps its twins; the expected costs come from the
+    cells' rows (twins counted where they run)."""
     from loopsim.sweeps import seeds_auto
 
     targets = seeding.SeedTargets(check_seeds=3)
@@ -183,10 +190,10 @@ def test_sampled_cells_drop_their_twins_and_are_checked_in_distribution():
     assert seeds_auto.expected_costs([cell], None) is None
     later = _rows(["3d"] * 4, [None] * 4).assign(seed=range(4, 8), round=1)
     rows = pd.concat([first, later], ignore_index=True)
+    assert seeds_auto.plan_check([cell], rows, targets) == []  # 4 twins make up 3
+    targets = dataclasses.replace(targets, check_seeds=7)
     check = seeds_auto.plan_check([cell], rows, targets)
-    assert [c["seed"] for c in check] == [4, 5, 6]  # the untwinned seeds first
-    assert [c["seed"] for c in seeds_auto.plan_check(  # then the twinned ones, in seed order
-        [cell], rows, dataclasses.replace(targets, check_seeds=6))] == [0, 1, 4, 5, 6, 7]
+    assert [c["seed"] for c in check] == [4, 5, 6]  # 4 twins + 3 untwinned seeds
     config = sweeps.SweepConfig(cases=[cell], rtol=1e-6, atol=1e-9, tail_tol=1e-5)
     strict = seeds_auto.check_config(config, check)
     assert (strict.rtol, strict.atol, strict.tail_tol, strict.twin) == pytest.approx(
@@ -194,10 +201,16 @@ def test_sampled_cells_drop_their_twins_and_are_checked_in_distribution():
     steady = dict(cell, g0=10.0)
     determined = _rows(["stable"] * 4, [True] * 4).assign(g0=10.0)
     assert seeds_auto.plan_check([steady], determined, targets) == []
+    checks = rows.iloc[4:7].assign(theta_final_deg=[40.0, 47, 54])
+    stricter = seeds_auto.stricter_sample([cell, steady], pd.concat([rows, determined]),
+                                          targets, checks)
+    assert list(stricter["seed"]) == [0, 1, 2, 3, 4, 5, 6]
+    assert list(stricter["theta_final_deg"]) == [10.0, 18, 24, 31, 40, 47, 54]  # twins' own
+    assert list(stricter["regime"][:4]) == ["3d", "3d", "in-plane", "3d"]
     table = seeds_auto.stop_table([cell, steady], pd.concat([rows, determined]), targets,
-                                  checks=rows.iloc[4:7].assign(theta_final_deg=[40.0, 47, 54]))
+                                  checks=checks)
     sampled, settled = table.iloc[0], table.iloc[1]
-    assert (sampled["runs"], sampled["twins"], sampled["check_seeds"]) == ("samples", 4, 3)
+    assert (sampled["runs"], sampled["twins"], sampled["check_seeds"]) == ("samples", 4, 7)
     assert sampled["check_verdict"] in (summary.SAME, summary.DIFFERENT)
     assert 0 <= sampled["check_tilt_ks_p"] <= 1 and sampled["check_tilt_wasserstein"] > 0
     assert (settled["runs"], settled["twins"], settled["check_seeds"]) == ("trajectories", 4, 0)
@@ -206,8 +219,10 @@ def test_sampled_cells_drop_their_twins_and_are_checked_in_distribution():
 
 def test_a_sampled_cell_end_to_end(tmp_path):
     """Twins that can never agree (determined_tilt_deg 1e-15) make every run a sample:
-    round 0 runs twins, round 1 none, and the check reruns check_seeds seeds at 10x
-    stricter tolerances into out/check; the stop table says so."""
+    round 0 runs twins, round 1 none, and the check runs the untwinned seeds at 10x
+    stricter tolerances into out/check, each exactly its seed's twin would be (the same
+    RHS count as a twin of that seed in a sweep with twins throughout); the stop table
+    says so."""
     from loopsim.outcomes import Thresholds
 
     config = sweeps.SweepConfig(cases=cells([60.0], [30.0]), t_end=0.3, method="rkf45",
@@ -215,14 +230,18 @@ def test_a_sampled_cell_end_to_end(tmp_path):
                                 thresholds=Thresholds(determined_tilt_deg=1e-15,
                                                       determined_aspect=1e-15))
     targets = seeding.SeedTargets(min_seeds=2, max_seeds=4, tilt_tol_deg=1e-12,
-                                  p_halfwidth=0.01, check_seeds=2)
+                                  p_halfwidth=0.01, check_seeds=4)
     out = tmp_path / "auto"
     rows, stops = run_seeds_auto(config, str(out), targets, run_round=runner([]))
     assert rows["twin_nfev"].gt(0).tolist() == [True, True, False, False]
     assert rows["determined"].tolist()[:2] == [False, False]
     check = loopsim.read_results(str(out / io.CHECK_DIR))
     assert list(check["seed"]) == [2, 3] and set(check["rtol"]) == {config.rtol / 10}
+    throughout = sweeps.run_sweep(dataclasses.replace(config, cases=sweeps.grid_cases(
+        [60.0], [30.0], [4], 4)), str(tmp_path / "twins"), threads=1, quiet=True)
+    assert list(check["nfev"]) == list(throughout["twin_nfev"][2:])
+    assert list(check["theta_final_deg"]) == list(throughout["twin_theta_final_deg"][2:])
     stop = stops.iloc[0]
-    assert (stop["runs"], stop["twins"], stop["check_seeds"]) == ("samples", 2, 2)
+    assert (stop["runs"], stop["twins"], stop["check_seeds"]) == ("samples", 2, 4)
     assert stop["check_verdict"] == summary.SAME  # 10x stricter: the same tilts to 1e-5
     pd.testing.assert_frame_equal(io.read_stop_table(str(out)), stops)

@@ -199,7 +199,8 @@ def requires_hash(stored):
 
 #: Columns added since result files were first written, with the value their rows had
 #: before (a file written earlier holds local-model rows without these columns).
-ADDED_COLUMNS = {"model": "local", "slenderness": None}
+ADDED_COLUMNS = {"model": "local", "slenderness": None, "twin_regime": None,
+                 "twin_theta_final_deg": None, "twin_aspect_ratio": None}
 
 
 def result_table(table):

@@ -28,7 +28,8 @@ RUN_FIELDS = ("method", "n_used", "status", "t_final", "steps_accepted", "steps_
               "nfev", "njev", "nlu", "wall_s", "tail_max")
 #: What the end state means (``loopsim.outcomes``).
 OUTCOME_FIELDS = ("regime", "resolved", "determined", "theta_uncertainty_deg",
-                  "aspect_uncertainty", "twin_nfev")
+                  "aspect_uncertainty", "twin_nfev", "twin_regime", "twin_theta_final_deg",
+                  "twin_aspect_ratio")
 SUMMARY_FIELDS = (INPUT_FIELDS + RUN_FIELDS + tuple(d.name for d in diagnostics.REGISTRY)
                   + OUTCOME_FIELDS)
 
@@ -39,6 +40,7 @@ _SUMMARY_TYPES = {
     "steps_accepted": _INT,
     "steps_rejected": _INT, "nfev": _INT, "njev": _INT, "nlu": _INT,
     "regime": pa.string(), "resolved": pa.bool_(), "determined": pa.bool_(), "twin_nfev": _INT,
+    "twin_regime": pa.string(),
     **{d.name: pa.from_numpy_dtype(np.dtype(d.dtype)) for d in diagnostics.REGISTRY},
 }
 #: The declared schema of every sweep chunk (and of :func:`read_results`); each field

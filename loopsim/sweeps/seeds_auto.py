@@ -158,20 +158,40 @@ def expected_costs(cases, rows, twins=True):
     return costs
 
 
+def _twinned(rows):
+    """The rows whose twin's outcome is recorded (``twin_regime``)."""
+    if "twin_regime" not in rows:
+        return rows.iloc[:0]
+    return rows[rows["twin_regime"].notna()]
+
+
 def plan_check(cells, rows, targets):
-    """The distribution check's cases: for each sampled cell (:func:`_sampled`), up to
-    ``check_seeds`` of its seeds, those that ran without a twin first (a twin is already
-    the stricter run of its seed), each in seed order."""
+    """The distribution check's cases: for each sampled cell (:func:`_sampled`), the
+    stricter sample is its twins (each the run of its seed at the stricter tolerances,
+    recorded in its row) topped up to ``check_seeds`` with seeds that ran without a twin,
+    in seed order: those are the cases to run."""
     groups = _groups(rows)
     cases = []
     for cell in cells:
         have = groups[cell_key(cell)]
         if _sampled(have, targets):
-            order = have.assign(twinned=have["determined"].notna()).sort_values(
-                ["twinned", "seed"], kind="stable")
-            seeds = sorted(int(s) for s in order["seed"].iloc[:targets.check_seeds])
-            cases.extend(dict(cell, seed=seed) for seed in seeds)
+            need = max(0, targets.check_seeds - len(_twinned(have)))
+            untwinned = sorted(int(s) for s in have["seed"][~have.index.isin(
+                _twinned(have).index)])
+            cases.extend(dict(cell, seed=seed) for seed in untwinned[:need])
     return cases
+
+
+def stricter_sample(cells, rows, targets, checks):
+    """The stricter sample of every sampled cell: its twins' outcomes (as rows: regime,
+    tilt and aspect ratio the twin's) and its check runs (``checks``, or None)."""
+    groups = _groups(rows)
+    twins = [_twinned(groups[cell_key(cell)]) for cell in cells
+             if _sampled(groups[cell_key(cell)], targets)]
+    twins = [t.assign(regime=t["twin_regime"], theta_final_deg=t["twin_theta_final_deg"],
+                      aspect_ratio=t["twin_aspect_ratio"]) for t in twins if len(t)]
+    frames = twins + ([checks] if checks is not None and len(checks) else [])
+    return pd.concat(frames, ignore_index=True) if frames else None
 
 
 def check_config(config, cases):
@@ -192,7 +212,8 @@ def stop_table(cells, rows, targets, checks=None):
     """One row per cell: its inputs, seeds, rounds, stop reason and interval half-widths;
     how its answer was decided (``runs``: "trajectories", each twin-checked or
     deterministic, or "samples"; ``twins``: rows with a twin) and, for sampled cells, the
-    distribution check against its stricter subsample (``checks``: the check's rows)."""
+    distribution check against its stricter sample (``check_seeds`` of them: its twins and
+    its check runs, ``checks``; :func:`stricter_sample`)."""
     groups = _groups(rows)
     table = pd.DataFrame([
         dict(seeding.cell_record(CELL_KEYS, cell_key(cell), groups[cell_key(cell)], targets,
@@ -205,10 +226,11 @@ def stop_table(cells, rows, targets, checks=None):
         name: float("nan") for name in CHECK_COLUMNS.values()
         if name not in ("check_seeds", "check_verdict")})
     table = table.assign(**empty)
-    if checks is not None and len(checks):
+    stricter = stricter_sample(cells, rows, targets, checks)
+    if stricter is not None:
         sampled = pd.concat([groups[cell_key(cell)] for cell in cells
                              if _sampled(groups[cell_key(cell)], targets)])
-        verdicts = summary.compare(sampled, checks, by=list(CELL_KEYS)).rename(
+        verdicts = summary.compare(sampled, stricter, by=list(CELL_KEYS)).rename(
             columns=CHECK_COLUMNS)
         keys = list(CELL_KEYS)
         table = table.drop(columns=list(CHECK_COLUMNS.values())).merge(
@@ -267,7 +289,7 @@ def run_seeds_auto(config, out, targets, *, run_round, command_line=None, announ
         raise
     checks = None
     cases = plan_check(cells, rows, targets) if config.twin else []  # --no-twin: no check
-    if cases:
+    if cases:  # (a cell whose twins make up check_seeds is checked against them alone)
         if announce is not None:
             announce(f"seeds auto: distribution check: {len({cell_key(c) for c in cases})} "
                      f"cells whose runs are samples, {len(cases)} cases at 10x stricter "
