@@ -3,6 +3,7 @@ missing #anchor or an API reference to a name that no longer exists fails the su
 The API page is read from the source by mkdocstrings (griffe, statically: nothing of
 loopsim is imported)."""
 import os
+import re
 import subprocess
 import sys
 
@@ -20,3 +21,122 @@ def test_docs_build_strict(tmp_path):
     api = site / "api" / "index.html"
     assert api.is_file()
     assert "simulate" in api.read_text(encoding="utf-8")
+
+
+# ---------------------------------------------------------------------------------
+# The pages' Markdown, read as text: what MkDocs (Python-Markdown) would render wrongly
+# without failing the build, and the rules that keep the reference a reference.
+
+DOCS = os.path.join(ROOT, "docs")
+MAX_LINES = 400
+LIST_ITEM = re.compile(r"^\s*(?:[*+-]|\d+[.)])\s+\S")
+TABLE_RULE = re.compile(r"^\s*\|?\s*:?-{3,}:?\s*(?:\|\s*:?-{3,}:?\s*)*\|?\s*$")
+
+
+def pages():
+    """Every Markdown page of docs/, by file name."""
+    return sorted(name for name in os.listdir(DOCS) if name.endswith(".md"))
+
+
+def page_text(name):
+    with open(os.path.join(DOCS, name), encoding="utf-8") as handle:
+        return handle.read()
+
+
+def prose_lines(text):
+    """(line number, line) outside fenced code blocks; fenced lines come back as None, so
+    that a fence still separates the blocks around it."""
+    fenced = False
+    for number, line in enumerate(text.splitlines(), 1):
+        if line.lstrip().startswith("```"):
+            fenced = not fenced
+            yield number, None
+        else:
+            yield number, None if fenced else line
+
+
+def cells(row):
+    """The cells of a table row: split at every `|` but an escaped one (`\\|`, text).
+    Python-Markdown would keep a `|` inside backticks as text, GitHub would not: a
+    row must read the same on both, so a code span does not protect its `|`."""
+    row = row.strip().replace("\\|", "")
+    if row.startswith("|"):
+        row = row[1:]
+    if row.endswith("|"):
+        row = row[:-1]
+    return row.split("|")
+
+
+def table_errors(text):
+    """Table rows whose number of cells differs from their header's."""
+    errors, lines = [], list(prose_lines(text))
+    for (number, line), (_, rule) in zip(lines, lines[1:]):
+        if line is None or rule is None or "|" not in line or not TABLE_RULE.match(rule):
+            continue
+        width = len(cells(line))
+        for row_number, row in lines[number + 1:]:
+            if row is None or not row.strip() or "|" not in row:
+                break
+            if len(cells(row)) != width:
+                errors.append(f"line {row_number}: {len(cells(row))} cells, header {width}")
+    return errors
+
+
+def unrendered_lists(text):
+    """List items that Python-Markdown reads as the paragraph above them continued (a
+    list must follow a blank line, a heading or another list item; GitHub renders it
+    either way, MkDocs does not), and paragraph lines read into the list item above
+    them (a list item's continuation lines are indented)."""
+    errors, state = [], "blank"  # of the previous line: blank, heading, para, list
+    after_list = False  # the last block before the blank lines was a list
+    for number, line in prose_lines(text):
+        if line is None or not line.strip():
+            after_list = after_list if state == "blank" else state == "list"
+            state = "blank"
+        elif line.lstrip().startswith("#"):
+            state = "heading"
+        elif LIST_ITEM.match(line):
+            if state == "para":
+                errors.append(f"line {number}: {line.strip()[:60]}")
+            state = "list"
+        elif state == "list" and not line.startswith(" "):
+            errors.append(f"line {number}: not indented, read into the item above: "
+                          f"{line.strip()[:40]}")
+        elif state == "list" or (state == "blank" and after_list and line.startswith("  ")):
+            state = "list"  # a list item's continuation
+        else:
+            state = "para"
+    return errors
+
+
+# Internal work items and a narrated development history have no place in a reference.
+INTERNAL = re.compile(
+    r"\bthe issue\b|\bissue's\b|\bissue \d+|\bthis session\b|\b(?:same|earlier|a) session\b"
+    r"|\btoday's\b|\b(?:January|February|March|April|May|June|July|August|September"
+    r"|October|November|December) \d{4}\b", re.I)
+
+
+def test_table_rows_have_their_headers_number_of_cells():
+    bad = {name: table_errors(page_text(name)) for name in pages()}
+    bad = {name: errors for name, errors in bad.items() if errors}
+    assert not bad, bad
+
+
+def test_lists_follow_a_blank_line():
+    bad = {name: unrendered_lists(page_text(name)) for name in pages()}
+    bad = {name: errors for name, errors in bad.items() if errors}
+    assert not bad, bad
+
+
+def test_the_checks_catch_what_they_are_for():
+    """Each check on a known-bad snippet, so that a check that can no longer fail
+    fails here."""
+    assert table_errors("| a | b |\n|---|---|\n| x | a | b |\n") == ["line 3: 3 cells, header 2"]
+    assert table_errors("| a | b |\n|---|---|\n| `x` | a \\| b |\n") == []
+    assert unrendered_lists("Read it:\n* one\n* two\n") == ["line 2: * one"]
+    assert unrendered_lists("Read it:\n\n* one\n  more\n* two\n\n  still two\n") == []
+    assert unrendered_lists("* one\nNot the item.\n") == [
+        "line 2: not indented, read into the item above: Not the item."]
+    assert unrendered_lists("## Head\n1. one\n```\ntext\n* not a list\n```\n") == []
+    assert INTERNAL.search("the issue's target") and INTERNAL.search("measured in December 2026")
+    assert not INTERNAL.search("issued by the sweep")
