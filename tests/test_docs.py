@@ -128,6 +128,11 @@ def test_lists_follow_a_blank_line():
     assert not bad, bad
 
 
+def test_no_page_is_over_400_lines():
+    long = {name: page_text(name).count("\n") for name in pages()}
+    assert not {name: n for name, n in long.items() if n > MAX_LINES}
+
+
 def test_the_checks_catch_what_they_are_for():
     """Each check on a known-bad snippet, so that a check that can no longer fail
     fails here."""
