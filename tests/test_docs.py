@@ -133,6 +133,11 @@ def test_no_page_is_over_400_lines():
     assert not {name: n for name, n in long.items() if n > MAX_LINES}
 
 
+def test_no_page_speaks_of_internal_work_items_or_dates():
+    found = {name: [m.group(0) for m in INTERNAL.finditer(page_text(name))] for name in pages()}
+    assert not {name: words for name, words in found.items() if words}
+
+
 def test_the_checks_catch_what_they_are_for():
     """Each check on a known-bad snippet, so that a check that can no longer fail
     fails here."""
@@ -145,3 +150,62 @@ def test_the_checks_catch_what_they_are_for():
     assert unrendered_lists("## Head\n1. one\n```\ntext\n* not a list\n```\n") == []
     assert INTERNAL.search("the issue's target") and INTERNAL.search("measured in December 2026")
     assert not INTERNAL.search("issued by the sweep")
+
+
+# ---------------------------------------------------------------------------------
+# One value per fact: a fact that several pages need is stated on one and linked from
+# the others. Each pattern matches any statement of its fact, whatever the value; the
+# fact may be stated on its page only (README.md counts as a page).
+
+FACTS = {
+    # where the stable half of the steady in-plane branch loses stability out of plane
+    "the steady branch's loss of stability": (
+        r"37\.55|q_loss_out_of_plane = \d|(?:stays?|is|remains?) stable[^.|]{0,60}?\bto q = \d"
+        r"|stable[^.|]{0,40}(?:up )?to (?:its|the) end"
+        r"|los\w+ (?:its )?(?:out-of-plane )?stability (?:out of (?:its )?plane )?at (?:q = )?\d",
+        "stability.md"),
+    # the resolved reference's orders and resolved rows
+    "the resolved reference's n_used and resolved counts": (
+        r"n_used:? \d+ \(\d+ cases?\)|\d+ of (?:the|its) 20 (?:rows|cases) are `resolved`"
+        r"|\d+ rows are `resolved`", "figures.md"),
+    # the n --n auto chooses for each regime
+    "--n auto's n per regime": (
+        r"stable loops (?:are resolved|need) at n = \d|in-plane loops need n = \d"
+        r"|\| stable \(q0 below 8\.9001\) \| \d", "README.md"),
+    # what the twin costs
+    "the twin's cost": (
+        r"halves the cost|about doubles|twin adds|2\.0[–-]3\.5|case costs [\d.–-]+ times"
+        r"|twin costs [\d.]+[–-][\d.]+ times",
+        "auto-and-determinacy.md"),
+    # how far a 1e-6 change of the start moves the terminal tilt
+    "a changed start's effect on the tilt": (r"by up to (?:26|57)°", "auto-and-determinacy.md"),
+}
+
+
+def fact_pages(pattern):
+    """The pages (docs/*.md and README.md) on which a fact's pattern matches."""
+    texts = {name: page_text(name) for name in pages()}
+    with open(os.path.join(ROOT, "README.md"), encoding="utf-8") as handle:
+        texts["README.md"] = handle.read()
+    return sorted(name for name, text in texts.items() if re.search(pattern, text))
+
+
+def test_each_fact_is_stated_on_one_page():
+    wrong = {}
+    for fact, (pattern, home) in FACTS.items():
+        found = fact_pages(pattern)
+        if found != [home]:
+            wrong[fact] = found
+    assert not wrong, wrong
+
+
+def test_the_n6_grid_and_the_main_job_have_one_name_each():
+    """`runs/phase` is the README's main job; the n = 6 grid is `runs/phase_n6`; "main
+    job" never names another grid."""
+    for name in pages():
+        for line in page_text(name).splitlines():
+            assert not ("6:90:15" in line and "runs/phase " in line + " "), (name, line)
+    for name in ("paper-comparison.md", "stability.md", "index.md", "choosing-n-method-rtol.md"):
+        text = page_text(name)
+        assert not re.search(r"main job \(n = 6\)|main job's curve|former main job"
+                             r"|resolved main-job grid|main-job grid", text), name
