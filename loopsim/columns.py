@@ -109,9 +109,12 @@ def field_metadata(name, table=RESULT_COLUMNS):
 
 
 def markdown(table=RESULT_COLUMNS):
-    """The column table as Markdown (docs)."""
+    """The column table as Markdown (docs), a ``|`` inside a unit or a description
+    escaped as ``\\|`` so that it does not end its cell."""
+    def cell(text):
+        return text.replace("|", "\\|")
     lines = ["| column | unit | meaning |", "|---|---|---|"]
-    lines += [f"| `{name}` | {unit} | {text} |" for name, (unit, text) in table.items()]
+    lines += [f"| `{name}` | {cell(unit)} | {cell(text)} |" for name, (unit, text) in table.items()]
     return "\n".join(lines)
 
 

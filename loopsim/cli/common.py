@@ -79,8 +79,8 @@ def add_integration_options(parser):
                         "a fixed n, auto with --n auto)")
     parser.add_argument("--no-twin", action="store_true",
                         help="skip the twin run at 10x stricter tolerances that says whether "
-                        "each outcome is determined (about halves the cost; 'determined' is "
-                        "then empty)")
+                        "each outcome is determined (the twin costs more than the run "
+                        "itself; 'determined' is then empty)")
     parser.add_argument("--n-max", type=int, default=None,
                         help=f"with --n auto: the highest truncation order a case may reach "
                         f"(default: {DEFAULT_N_MAX})")
