@@ -222,7 +222,7 @@ def _check_rerun_options(args):
 def command(args):
     import numba
 
-    from .. import plots, sweeps, validation
+    from .. import figures, sweeps, validation
 
     if args.figure is not None:
         validation.check_output_file("--figure", args.figure)
@@ -314,7 +314,7 @@ def command(args):
 
             save_distribution_figure(summary.summarize(frame), frame, args.figure)
         else:
-            plots.save(plots.phase_diagram(frame), args.figure)
+            figures.save(figures.phase_diagram(frame), args.figure)
         print(f"{'distribution summary' if seeds_auto else 'phase diagram'}: {args.figure}")
     failed = int((frame["status"] != "ok").sum())
     if failed:
