@@ -5,7 +5,7 @@ report``, ``sweep_report``).  Plain constants, importable without NumPy, so that
 compiled kernels' cache valid."""
 
 #: ``loopsim animate``: the default most frames (evenly spaced stored snapshots), frames
-#: per second and dots per inch (a default GIF of a run is about 1 MB).
+#: per second and dots per inch (the docs' three GIFs of 60 frames: 290-630 kB).
 ANIMATION_FRAMES, ANIMATION_FPS, ANIMATION_DPI = 60, 10, 80
 #: Their bounds: a GIF grows with frames x dpi².
 ANIMATION_MAX_FRAMES, ANIMATION_MAX_FPS, ANIMATION_DPI_RANGE = 600, 60, (30, 200)

@@ -178,10 +178,38 @@ def report_html(sweep_dir, seed=0, costliest=COSTLIEST):
 
 
 def report(sweep_dir, out, seed=0, costliest=COSTLIEST):
-    """Write the HTML report of the sweep directory ``sweep_dir`` to ``out`` (one file,
-    images embedded as data URIs; atomically: a failed write leaves no file) and return
-    ``out``.  The output path is checked before any work; ValueError (one line) for an
-    unwritable ``out`` or a directory that cannot be read."""
+    """Write the one-page HTML report of a sweep directory.
+
+    The page (see the module docstring) holds the command and provenance, the counts by
+    regime, resolved and determined, the phase diagram (for ``--seeds auto``: the
+    regime probabilities and distribution panels), the failed cases with the rerun
+    command, the costliest cases and the total cost, and the per-cell table of
+    ``loopsim summary``.  Images are embedded as PNG data URIs; the page needs no
+    network and no JavaScript.
+
+    Parameters
+    ----------
+    sweep_dir : str or os.PathLike
+        A sweep directory (``loopsim sweep --out``), ``--seeds auto`` ones included.
+    out : str or os.PathLike
+        The HTML file to write.
+    seed : int, default 0
+        Seed of the per-cell table's bootstrap intervals (as ``loopsim summary --seed``).
+    costliest : int, default 10
+        How many of the costliest cases (largest ``wall_s``) to list.
+
+    Returns
+    -------
+    str or os.PathLike
+        ``out``.
+
+    Raises
+    ------
+    ValueError
+        One line: ``out`` cannot be written (checked before any work), or the directory
+        is missing, unreadable or holds no finished case.  The file is written
+        atomically: a failed write leaves none.
+    """
     from . import io, validation
 
     validation.check_output_file("out", out)

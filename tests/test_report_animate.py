@@ -139,8 +139,9 @@ def test_report_of_a_seeds_auto_directory_shows_the_distributions(tmp_path):
     config = sweeps.SweepConfig(cases=sweeps.grid_cases([10.0], [30.0], [4], 1), t_end=0.3,
                                 method="rkf45", twin=False, chunk_size=2)
     out = str(tmp_path / "auto")
-    rows, stops = run_seeds_auto(config, out, seeding.SeedTargets(), run_round=lambda c, d, weights=None:
-                                 sweeps.run_sweep(c, d, threads=1, quiet=True))
+    rows, stops = run_seeds_auto(config, out, seeding.SeedTargets(),
+                                 run_round=lambda c, d, weights=None: sweeps.run_sweep(
+                                     c, d, threads=1, quiet=True))
     target = tmp_path / "auto.html"
     loopsim.report(out, str(target))
     page, content = parse(target)

@@ -23,7 +23,8 @@ def add_parser(commands):
         formatter_class=HelpFormatter,
     )
     animate.add_argument("run", metavar="RUN",
-                         help="a run file (loopsim run --out) or a sweep directory (with --case-id)")
+                         help="a run file (loopsim run --out) or a sweep directory (with "
+                         "--case-id)")
     animate.add_argument("--out", required=True, metavar="FILE.gif|FILE.mp4",
                          help="the animation to write (atomically)")
     animate.add_argument("--case-id", type=int, default=None, metavar="K",

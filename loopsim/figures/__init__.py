@@ -29,6 +29,7 @@ as DataFrames, so every function can be drawn from stored numbers:
   linearisation of the circle, the nonlocal model beside the local one;
 * :func:`trajectory` - one run's snapshots, face-on, with tilt and aspect ratio;
 * :func:`save` - write a figure atomically;
+* :func:`animate` - a GIF or MP4 of one run (``loopsim animate``, module ``animation``);
 * :func:`write_figures` - all of them from files (``loopsim figures``).
 
 The modules: ``style`` (shared helpers and styles, :func:`save`), ``gallery`` (Fig. 4),
@@ -40,6 +41,7 @@ in-plane green-blue, 3D yellow); cases not resolved at their n are hollow.
 """
 from .. import diagnostics, spectral, validation  # noqa: F401  (names of the former module)
 from ..stability import circle, paper  # noqa: F401  (names of the former module)
+from .animation import animate, animation_figure, frame_indices, load_trajectory, write_animation
 from .distributions import (
     aspect_distribution, check_one_cell_per_point, distribution_summary, probability_phase_diagram,
     regime_pies, tilt_distribution, wedge_marker,
@@ -65,6 +67,7 @@ from .terminal import aspect_ratio, q_and_tilt, seed_distributions
 
 __all__ = [
     "ASPECT_LABEL", "CURVE_POINTS", "FIGURE_NAMES", "PAPER_BAND", "REGIME_STYLE", "TIME_CMAP",
+    "animate", "animation_figure", "frame_indices", "load_trajectory", "write_animation",
     "aspect_distribution", "aspect_ratio", "branch_lines", "centred_curve",
     "check_one_cell_per_point", "coefficients", "default_thresholds", "distribution_summary",
     "evolution", "evolution_rows", "frame_model", "gallery", "growth_rates", "load_branch",

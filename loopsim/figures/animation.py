@@ -81,7 +81,8 @@ def _series(trajectory):
     """(t, tilt in degrees, aspect ratio) per snapshot: the stored columns, or measured."""
     t = trajectory["t"].to_numpy(float)
     if {"theta_deg", "aspect_ratio"} <= set(trajectory):
-        return t, trajectory["theta_deg"].to_numpy(float), trajectory["aspect_ratio"].to_numpy(float)
+        return (t, trajectory["theta_deg"].to_numpy(float),
+                trajectory["aspect_ratio"].to_numpy(float))
     shapes = [coefficients(x) for x in trajectory["x"]]
     return (t, np.array([diagnostics.tilt_deg(x) for x in shapes]),
             np.array([diagnostics.aspect_ratio(x) for x in shapes]))
@@ -227,16 +228,45 @@ def load_trajectory(source, case_id=None):
 
 
 def animate(source, out, case_id=None, frames=FRAMES, fps=FPS, dpi=DPI):
-    """Animate one run into ``out`` (.gif, or .mp4 where ffmpeg is on PATH) and return
-    the number of frames written.
+    """Animate one run into a GIF or MP4 file.
 
-    ``source``: a run file (``loopsim run --out``), a sweep directory with ``case_id``
-    (a case recorded with ``--snapshots-for``), a ``SimulationResult`` or a trajectory
-    DataFrame.  The frames are the run's stored snapshots, at most ``frames`` of them
-    evenly spaced (no interpolation between snapshots); ``fps`` frames per second;
-    ``dpi`` dots per inch of the 8.4 x 3.8 inch figure.  See the module docstring for
-    what a frame shows.  The output is checked before anything is read, and written
-    atomically; ValueError (one line) for bad input."""
+    Each frame shows the loop in 3D, centred on its centre of mass and coloured by the
+    axial force N = T + |x''|², with its shadows on the floor and on the y-z wall, beside
+    the tilt and the aspect ratio against time with a marker at the frame's time (see
+    the module docstring).  The frames are the run's stored snapshots: nothing is
+    interpolated between them.
+
+    Parameters
+    ----------
+    source : str, os.PathLike, SimulationResult or pandas.DataFrame
+        A run file (``loopsim run --out``), a sweep directory (with ``case_id``), a
+        ``SimulationResult`` (``loopsim.simulate``) or a trajectory table (columns
+        ``t``, ``x``, ``multiplier``).
+    out : str or os.PathLike
+        The file to write: ``.gif`` (Pillow) or ``.mp4`` (needs ffmpeg on PATH).
+    case_id : int, optional
+        With a sweep directory: the case, recorded with ``--snapshots-for``.
+    frames : int, default 60
+        Most frames (2 to 600): evenly spaced stored snapshots, first and last included;
+        every snapshot when the run has fewer.
+    fps : int, default 10
+        Frames per second (1 to 60).
+    dpi : int, default 80
+        Dots per inch of the 8.4 x 3.8 inch frames (30 to 200; 80 gives 672 x 304 pixels).
+
+    Returns
+    -------
+    int
+        The number of frames written.
+
+    Raises
+    ------
+    ValueError
+        One line, before anything is written: an output that is not a writable .gif or
+        .mp4 path (an .mp4 without ffmpeg names the .gif instead), an option out of
+        bounds, a sweep case that is not there or has no snapshots, a run with fewer
+        than 2 snapshots.  The file is written atomically: a failed write leaves none.
+    """
     check_output(out)
     trajectory, title = load_trajectory(source, case_id)
     return write_animation(trajectory, out, title, frames=frames, fps=fps, dpi=dpi)

@@ -4,8 +4,8 @@ from matplotlib.ticker import MaxNLocator
 
 from .linear import branch_lines
 from .style import (
-    ASPECT_LABEL, default_thresholds, new_figure, order_column, orders_text, q_lines, scatter_regimes,
-    single_axes,
+    ASPECT_LABEL, default_thresholds, new_figure, order_column, orders_text, q_lines,
+    scatter_regimes, single_axes,
 )
 
 
