@@ -72,7 +72,7 @@ def _counts_text(counts):
 def _provenance(meta, sweep_dir):
     command = meta.get("command_line") or []
     created = (meta.get("created_utc_first"), meta.get("created_utc_last"))
-    rows = [("sweep directory", os.path.abspath(sweep_dir)),
+    rows = [("sweep directory", sweep_dir),
             ("loopsim version", meta.get("loopsim_version", "not recorded")),
             ("created (UTC)", created[0] if created[0] == created[1]
              else f"{created[0]} to {created[1]}"),

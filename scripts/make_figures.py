@@ -271,10 +271,13 @@ def loopsim(args, dry_run, max_wall=None):
     if max_wall is None:
         from loopsim import cli
 
+        argv, sys.argv = sys.argv, ["loopsim", *args]  # what a sweep records as its command
         try:
             code = cli.main(list(args))
         except SystemExit as exc:  # argparse
             code = exc.code if isinstance(exc.code, int) else 2
+        finally:
+            sys.argv = argv
     else:
         process = subprocess.Popen(command)
         try:
