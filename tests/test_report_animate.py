@@ -213,6 +213,11 @@ def test_animate_refuses_bad_input_and_leaves_nothing(sweep, tmp_path, capsys, m
             ".gif or .mp4")
     refused(["animate", out, "--case-id", str(cases[0]), "--out", gif, "--frames", "1"],
             "--frames")
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    refused(["animate", out, "--case-id", str(cases[0]), "--out", str(blocker / "a.gif")],
+            "--out")
+    blocker.unlink()
     monkeypatch.setattr("shutil.which", lambda name: None)
     refused(["animate", out, "--case-id", str(cases[0]), "--out", str(tmp_path / "a.mp4")],
             "ffmpeg", "a.gif")
