@@ -106,16 +106,20 @@ def _counts(counts, stopped):
 
 
 def _figures(frame, cells, seeds_auto):
+    """The figure section: the diagram, or why it is not drawn (a table that mixes models,
+    or holds several cells at one point: the figure functions refuse those)."""
     from . import figures
 
-    if seeds_auto:
-        images = [("regime probabilities per cell and distributions over seeds",
-                   figures.distribution_summary(cells, frame))]
-    else:
-        images = [("phase diagram", figures.phase_diagram(frame))]
-    return "".join(f"<h2>{html.escape(title.capitalize())}</h2>"
-                   f"<img alt='{html.escape(title)}' src='{png_data_uri(fig)}'>"
-                   for title, fig in images)
+    title = ("regime probabilities per cell and distributions over seeds" if seeds_auto
+             else "phase diagram")
+    try:
+        fig = (figures.distribution_summary(cells, frame) if seeds_auto
+               else figures.phase_diagram(frame))
+    except ValueError as exc:
+        return (f"<h2>{html.escape(title.capitalize())}</h2><p class='warn'>not drawn: "
+                f"{html.escape(str(exc))}</p>")
+    return (f"<h2>{html.escape(title.capitalize())}</h2>"
+            f"<img alt='{html.escape(title)}' src='{png_data_uri(fig)}'>")
 
 
 def _failed(frame, sweep_dir):

@@ -233,3 +233,21 @@ def test_animate_refuses_a_case_without_snapshots(tmp_path, capsys):
     err = capsys.readouterr().err
     assert "has no snapshots" in err and "--snapshots-for 0" in err and err.count("\n") == 1
     assert not target.exists()
+
+
+def test_report_names_a_diagram_it_cannot_draw(sweep, tmp_path, monkeypatch):
+    """A table the figure functions refuse (several models, several cells at one point)
+    still gets its page, with the reason in place of the diagram."""
+    from loopsim import figures
+
+    out, _ = sweep
+
+    def refuse(frame, *args, **kwargs):
+        raise ValueError("the table mixes models [('local', None), ('nonlocal', 0.01)]")
+
+    monkeypatch.setattr(figures, "phase_diagram", refuse)
+    target = tmp_path / "r.html"
+    loopsim.report(out, str(target))
+    page, content = parse(target)
+    assert page.images == [] and "not drawn: the table mixes models" in content
+    assert len(page.tables["cells"]) == 5
