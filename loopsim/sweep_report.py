@@ -213,6 +213,12 @@ def report(sweep_dir, out, seed=0, costliest=COSTLIEST):
         One line: ``out`` cannot be written (checked before any work), or the directory
         is missing, unreadable or holds no finished case.  The file is written
         atomically: a failed write leaves none.
+
+    Examples
+    --------
+    >>> import loopsim
+    >>> loopsim.report("runs/phase", "runs/phase.html")  # doctest: +SKIP
+    'runs/phase.html'
     """
     from . import io, validation
 

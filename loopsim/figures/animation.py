@@ -244,7 +244,7 @@ def animate(source, out, case_id=None, frames=FRAMES, fps=FPS, dpi=DPI):
         ``t``, ``x``, ``multiplier``).
     out : str or os.PathLike
         The file to write: ``.gif`` (Pillow) or ``.mp4`` (needs ffmpeg on PATH).
-    case_id : int, optional
+    case_id : int or None, default None
         With a sweep directory: the case, recorded with ``--snapshots-for``.
     frames : int, default 60
         Most frames (2 to 600): evenly spaced stored snapshots, first and last included;
@@ -266,6 +266,17 @@ def animate(source, out, case_id=None, frames=FRAMES, fps=FPS, dpi=DPI):
         .mp4 path (an .mp4 without ffmpeg names the .gif instead), an option out of
         bounds, a sweep case that is not there or has no snapshots, a run with fewer
         than 2 snapshots.  The file is written atomically: a failed write leaves none.
+
+    Examples
+    --------
+    A run stored with 121 snapshots (``loopsim run ... --snapshots 121 --out
+    runs/3d.parquet``), drawn as 60 of them:
+
+    >>> import loopsim
+    >>> loopsim.animate("runs/3d.parquet", "runs/3d.gif")  # doctest: +SKIP
+    60
+    >>> loopsim.animate("runs/phase", "case7.gif", case_id=7, frames=30)  # doctest: +SKIP
+    30
     """
     check_output(out)
     trajectory, title = load_trajectory(source, case_id)
