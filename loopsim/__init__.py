@@ -26,6 +26,7 @@ _EXPORTS = {
     "SUMMARY_FIELDS": "api", "stability_parameter": "diagnostics",
     "coefficients": "io", "read_results": "io", "read_snapshots": "io", "sweep": "sweeps",
     "summarize": "summary", "compare": "summary",
+    "animate": "figures.animation", "report": "sweep_report",
 }
 __all__ = list(_EXPORTS) + ["__version__"]
 

@@ -136,6 +136,59 @@ def summarize(frame, by=None, seed=0):
     return table
 
 
+# ---- what a sweep's closing lines (``loopsim sweep``) and its report count ------------
+#: The command a sweep's closing line and its report give for rerunning failed cases
+#: (``{out}``: the sweep directory).
+RERUN_COMMAND = "loopsim sweep --rerun-failed {out} --method radau5"
+#: Columns of :func:`costliest` (those present in the table).
+COST_COLUMNS = ("case_id", "round", "g0", "theta0_deg", "seed", "n_used", "method", "regime",
+                "status", "wall_s", "nfev", "twin_nfev")
+
+
+def _regime_counts(rows):
+    return {str(k): int(v) for k, v in sorted(rows["regime"].value_counts().items())}
+
+
+def outcome_counts(frame):
+    """The counts of a results table (``read_results``) that ``loopsim sweep`` closes
+    with: ``cases``; ``regimes`` ({regime: rows}); ``unresolved`` (rows not resolved at
+    their n) and ``undetermined`` (rows whose twin ends elsewhere), each with the regimes
+    among them (``unresolved_regimes``, ``undetermined_regimes``); ``failed`` (rows whose
+    ``status`` is not "ok")."""
+    unresolved = frame[~frame["resolved"].astype(bool)]
+    undetermined = frame[frame["determined"].eq(False)]
+    return dict(cases=len(frame), regimes=_regime_counts(frame), unresolved=len(unresolved),
+                unresolved_regimes=_regime_counts(unresolved), undetermined=len(undetermined),
+                undetermined_regimes=_regime_counts(undetermined),
+                failed=int((frame["status"] != "ok").sum()))
+
+
+def stop_counts(stops):
+    """The counts of a ``--seeds auto`` stop table (``io.read_stop_table``) that ``loopsim
+    sweep`` closes with: ``points``, ``reasons`` ({stop_reason: points}), ``seeds_min``,
+    ``seeds_max`` (seeds per point)."""
+    return dict(points=len(stops),
+                reasons={str(k): int(v) for k, v in
+                         sorted(stops["stop_reason"].value_counts().items())},
+                seeds_min=int(stops["seeds"].min()), seeds_max=int(stops["seeds"].max()))
+
+
+def cost(frame):
+    """The total cost of a results table: ``cases``, ``wall_s`` (seconds of integration,
+    summed over the rows), ``nfev`` and ``twin_nfev`` (right-hand-side evaluations of the
+    runs and of their twins, summed)."""
+    return dict(cases=len(frame), wall_s=float(frame["wall_s"].sum()),
+                nfev=int(frame["nfev"].sum()),
+                twin_nfev=int(frame["twin_nfev"].fillna(0).sum()) if "twin_nfev" in frame else 0)
+
+
+def costliest(frame, count=10):
+    """The ``count`` rows of a results table with the largest ``wall_s`` (their
+    :data:`COST_COLUMNS`), costliest first."""
+    shown = [c for c in COST_COLUMNS if c in frame]
+    return frame.sort_values("wall_s", ascending=False, kind="stable")[shown].head(count)
+
+
 # ---- convergence in distribution: two sweeps of the same cells ---------------------------
 #: The verdicts of :func:`compare`.
 SAME, DIFFERENT = "indistinguishable at this sample size", "different"

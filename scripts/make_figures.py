@@ -5,8 +5,10 @@ Usage: python scripts/make_figures.py [--runs runs] [--out docs/figures] [--thre
                                       [--quick] [--n24] [--dry-run]
 
 Runs what the figures need into --runs (gitignored; a finished run file is kept, a sweep
-resumes, so a second call only draws), then draws each PNG of docs/figures/ with
-loopsim.figures and loopsim.plots (the functions behind ``loopsim figures``, ``sweep
+resumes, so a second call only draws), then draws each PNG of docs/figures/ (and the
+GIF animations and the example HTML report, through ``loopsim animate`` and ``loopsim
+report``) with
+loopsim.figures (the functions behind ``loopsim figures``, ``sweep
 --figure`` and ``summary --figure``, the last one through the command itself).
 ``--only`` draws the named figures (stems of the PNG files, see ``--list``) and runs only
 the steps they need.  ``--quick`` exercises every step and every drawing end to end on
@@ -48,6 +50,10 @@ The steps (the runs), with the figures that need them:
   nonlocal SBT (``--model nonlocal --slenderness``; at 1e-2 the ladder ends at n = 10):
   phase_nonlocal_eps1e-2, phase_nonlocal_eps1e-3, and with ``main_job``
   nonlocal_outcomes (docs/nonlocal.md);
+* ``movie_stable``, ``movie_in_plane``, ``movie_3d``: g0 = 10, θ0 = 30° (t = 6);
+  g0 = 60, θ0 = 30° (t = 6); g0 = 150, θ0 = 60° (t = 3), each at ``--n auto`` with 121
+  snapshots: anim_stable, anim_in_plane, anim_3d (``loopsim animate``, GIF); ``main_job``
+  also gives report_main_job.html (``loopsim report``);
 * ``resolved_n24`` (only with --n24): 4 cases at fixed n = 24 (radau5, rtol 1e-7), a
   check not drawn.
 
@@ -89,6 +95,12 @@ FIXED_N24 = ["--method", "radau5", "--rtol", "1e-7", "--atol", "1e-10"]
 NONLOCAL_SLENDERNESS = ("1e-2", "1e-3")
 #: Figures of loopsim figures at this resolution; the phase diagrams as sweep --figure draws them.
 DPI, PHASE_DPI = 110, 200
+#: Figures drawn at a lower resolution to stay under 300 kB (fig6_evolution: three rows).
+FIGURE_DPI = {"fig6_evolution": 80}
+#: The animations of docs/getting-started.md, one per regime: (run step, g0, θ0, t_end),
+#: each at ``--n auto`` with 121 snapshots, drawn by ``loopsim animate`` (60 frames).
+MOVIES = (("movie_stable", "10", "30", "6"), ("movie_in_plane", "60", "30", "6"),
+          ("movie_3d", "150", "60", "3"))
 
 
 def resolved_cases(path, quick=False):
@@ -170,6 +182,13 @@ def steps(runs, threads, quick=False, n24=False):
         *(sweep(f"nonlocal_eps{eps}", *main_job, *auto_quick, "--model", "nonlocal",
                 "--slenderness", eps, *lean, capped=True) for eps in NONLOCAL_SLENDERNESS),
     ])
+    # the animations' runs: many snapshots, each ending once its shape has settled
+    movie_snapshots = "5" if quick else "121"
+    for name, g0, theta0, t_end in MOVIES:
+        path = os.path.join(fig, f"{name}.parquet")
+        out[name] = (path, ["run", "--g0", g0, "--theta0", theta0, "--n", "auto",
+                            "--t-end", "0.5" if quick else t_end, "--snapshots", movie_snapshots,
+                            *lean, "--out", path], False)
     out["main_job"] = out.pop("phase")  # the README's --out runs/phase, under a clearer name
     if n24:
         out.update([sweep("resolved_n24", "--cases", os.path.join(fig, "n24_cases.csv"),
@@ -181,8 +200,9 @@ def targets(quick=False):
     """{figure stem: (steps it needs, how it is drawn)}: every PNG of docs/figures/.  How:
     ("figures", main step, other steps, loopsim figures' name, its output stem), ("phase",
     step) for a plain phase diagram, ("summary", step) for ``loopsim summary --figure``,
-    ("stability",), ("nonlocal_stability",), or ("models", step, step, ...) for
-    ``plots.model_outcomes`` (one column per step's model)."""
+    ("stability",), ("nonlocal_stability",), ("models", step, step, ...) for
+    ``figures.model_outcomes`` (one column per step's model), ("animate", step) for
+    ``loopsim animate`` (a GIF) or ("report", step) for ``loopsim report`` (an HTML page)."""
     runs3 = ["g150_t60_n6", "g150_t60_n16", "g150_t60_auto"]
     nonlocal_steps = [f"nonlocal_eps{eps}" for eps in NONLOCAL_SLENDERNESS]
     return {
@@ -215,6 +235,8 @@ def targets(quick=False):
         "seed_cells": (["seed_cells"], ("summary", "seed_cells")),
         "seeds_auto_study": (["seeds_auto_study"], ("summary", "seeds_auto_study")),
         "seeds_auto_grid": (["seeds_auto_grid"], ("summary", "seeds_auto_grid")),
+        **{f"anim_{step[len('movie_'):]}": ([step], ("animate", step)) for step, *_ in MOVIES},
+        "report_main_job": (["main_job"], ("report", "main_job")),
         "seed_distributions": (["seeds_n6", "seeds_auto"],
                                ("figures", "seeds_n6", ["seeds_n6", "seeds_auto"], "seeds",
                                 "seed_distributions")),
@@ -230,7 +252,7 @@ def needed_steps(names, table):
         need.update(own)
         if how[0] == "figures":
             need.add(how[1])
-        elif how[0] in ("phase", "summary"):
+        elif how[0] in ("phase", "summary", "animate", "report"):
             need.add(how[1])
     return need
 
@@ -249,10 +271,13 @@ def loopsim(args, dry_run, max_wall=None):
     if max_wall is None:
         from loopsim import cli
 
+        argv, sys.argv = sys.argv, ["loopsim", *args]  # what a sweep records as its command
         try:
             code = cli.main(list(args))
         except SystemExit as exc:  # argparse
             code = exc.code if isinstance(exc.code, int) else 2
+        finally:
+            sys.argv = argv
     else:
         process = subprocess.Popen(command)
         try:
@@ -277,22 +302,26 @@ def draw(name, how, paths, out, work, quick):
     import matplotlib
 
     matplotlib.use("Agg")
-    from loopsim import figures, plots, read_results
+    from loopsim import figures, read_results
 
-    target = os.path.join(out, f"{name}.png")
     kind = how[0]
-    if kind == "stability":
+    target = os.path.join(out, name + {"animate": ".gif", "report": ".html"}.get(kind, ".png"))
+    if kind == "animate":
+        loopsim(["animate", paths[how[1]], "--out", target], dry_run=False)
+    elif kind == "report":
+        loopsim(["report", paths[how[1]], "--out", target], dry_run=False)
+    elif kind == "stability":
         n = 6 if quick else 16
         fig = figures.stability(*figures.stability_data(n=n, n_values=range(3, n + 1)))
-        plots.save(fig, target, dpi=DPI)
+        figures.save(fig, target, dpi=DPI)
     elif kind == "nonlocal_stability":
         eps = (1e-2, 1e-4) if quick else (1e-2, 3e-3, 1e-3, 1e-4, 1e-6, 1e-9, 1e-12)
-        plots.save(plots.nonlocal_thresholds(eps, n=6 if quick else 8), target, dpi=DPI)
+        figures.save(figures.nonlocal_thresholds(eps, n=6 if quick else 8), target, dpi=DPI)
     elif kind == "models":
         frames = [read_results(paths[step]) for step in how[1:]]
-        plots.save(plots.model_outcomes(frames), target, dpi=DPI)
+        figures.save(figures.model_outcomes(frames), target, dpi=DPI)
     elif kind == "phase":
-        plots.save(plots.phase_diagram(read_results(paths[how[1]])), target, dpi=PHASE_DPI)
+        figures.save(figures.phase_diagram(read_results(paths[how[1]])), target, dpi=PHASE_DPI)
     elif kind == "summary":
         loopsim(["summary", paths[how[1]], "--figure", target], dry_run=False)
     else:
@@ -301,7 +330,8 @@ def draw(name, how, paths, out, work, quick):
         shutil.rmtree(staging, ignore_errors=True)
         written = figures.write_figures(paths[main], [paths[o] for o in others], staging,
                                         only=[figure], stability_n=6 if quick else 16,
-                                        branch_n=6 if quick else 12, dpi=DPI, log=lambda _: None)
+                                        branch_n=6 if quick else 12,
+                                        dpi=FIGURE_DPI.get(name, DPI), log=lambda _: None)
         if stem not in written:
             raise SystemExit(f"make_figures: {name}: loopsim figures drew {sorted(written)}, "
                              f"not {stem}")

@@ -4,7 +4,7 @@ Usage: python scripts/plot_trajectory.py RUN.parquet FIGURE.png
 
 Left: the snapshots seen face-on (projected on the last shape's principal plane),
 centred on the centre of mass, coloured by time with a colour bar; right: tilt and
-aspect ratio against time (``loopsim.plots.trajectory``).
+aspect ratio against time (``loopsim.figures.trajectory``).
 """
 import sys
 
@@ -14,14 +14,14 @@ matplotlib.use("Agg")
 
 import pyarrow.parquet as pq  # noqa: E402
 
-from loopsim import io, plots  # noqa: E402
+from loopsim import figures, io  # noqa: E402
 
 
 def main(path, figure):
     summary = io.read_metadata(path)["summary"]
     title = f"g0 = {summary['g0']:g}, θ0 = {summary['theta0_deg']:g}°, n = {summary['n']}"
-    fig = plots.trajectory(pq.read_table(path).to_pandas(), summary["n"], title)
-    plots.save(fig, figure, dpi=150)
+    fig = figures.trajectory(pq.read_table(path).to_pandas(), summary["n"], title)
+    figures.save(fig, figure, dpi=150)
     print(f"wrote {figure}")
 
 

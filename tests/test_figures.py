@@ -18,7 +18,7 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 import pytest  # noqa: E402
 
-from loopsim import diagnostics, figures, plots, spectral  # noqa: E402
+from loopsim import diagnostics, figures, spectral  # noqa: E402
 from loopsim.cli import main  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -79,7 +79,7 @@ def close_figures():
 
 def test_import_leaves_the_backend_alone():
     code = ("import matplotlib; before = matplotlib.get_backend(); "
-            "import loopsim.figures, loopsim.plots, loopsim.cli; "
+            "import loopsim.figures, loopsim.cli; "
             "assert matplotlib.get_backend() == before == 'svg', matplotlib.get_backend()")
     env = dict(os.environ, MPLBACKEND="svg")
     subprocess.run([sys.executable, "-c", code], check=True, env=env, cwd=ROOT)
@@ -105,12 +105,12 @@ def test_gallery_draws_side_and_plane_views_in_regime_colours():
     key = [t.get_text() for t in fig.legends[0].get_texts()]
     drawn_regimes = frame[frame["theta0_deg"] == 30.0]["regime"]
     for regime in drawn_regimes:
-        assert plots.REGIME_STYLE[regime]["label"] in key
+        assert figures.REGIME_STYLE[regime]["label"] in key
     assert "θ0 = 30° (initial tilt)" in fig._suptitle.get_text()
     assert "terminal θ" in fig.axes[0].get_title()
     cases = frame[frame["theta0_deg"] == 30.0]
     assert len(fig.axes) == 2 * len(cases)
-    expected = [plots.REGIME_STYLE[r]["color"] for r in cases.sort_values("g0")["regime"]]
+    expected = [figures.REGIME_STYLE[r]["color"] for r in cases.sort_values("g0")["regime"]]
     side = fig.axes[: len(cases)]
     drawn = [matplotlib.colors.to_hex(ax.get_lines()[-1].get_color()) for ax in side]
     assert drawn == [matplotlib.colors.to_hex(c) for c in expected]
@@ -148,10 +148,10 @@ def test_phase_diagram_of_n_auto_rows_names_n_used_and_draws_its_linearisation()
     full-linearisation curves are those of the largest n_used."""
     from loopsim.stability import circle
 
-    title = plots.phase_diagram(auto_table()).axes[0].get_title()
+    title = figures.phase_diagram(auto_table()).axes[0].get_title()
     assert f"n auto (n_used = {N}, {N + 2})" in title
-    assert f"n = {N}," in plots.phase_diagram(table()).axes[0].get_title()
-    labels = [t.get_text() for t in plots.phase_diagram(auto_table()).axes[0].get_legend().get_texts()]
+    assert f"n = {N}," in figures.phase_diagram(table()).axes[0].get_title()
+    labels = [t.get_text() for t in figures.phase_diagram(auto_table()).axes[0].get_legend().get_texts()]
     q_in_plane = circle.critical_q(N + 2, "in-plane")
     assert any(f"q = {q_in_plane:.3f}" in text for text in labels)
 
@@ -167,10 +167,10 @@ def test_nonlocal_tables_draw_their_models_thresholds_side_by_side():
     nonlocal_table = table().assign(model="nonlocal", slenderness=1e-3)
     model = models.choose("nonlocal", 1e-3)
     q_in = circle.critical_q(N, "in-plane", model=model)
-    fig = plots.phase_diagram(nonlocal_table)
+    fig = figures.phase_diagram(nonlocal_table)
     assert "ε = 0.001" in fig.axes[0].get_title()
     assert any(f"q = {q_in:.3f}" in t.get_text() for t in fig.axes[0].get_legend().get_texts())
-    fig = plots.model_outcomes([local, nonlocal_table])
+    fig = figures.model_outcomes([local, nonlocal_table])
     assert len(fig.axes) == 4
     lines = lambda ax: sorted(round(line.get_xdata()[0], 6) for line in ax.get_lines())
     assert lines(fig.axes[2]) == sorted(round(circle.critical_q(N, s), 6)
@@ -178,22 +178,22 @@ def test_nonlocal_tables_draw_their_models_thresholds_side_by_side():
     assert round(q_in, 6) in lines(fig.axes[3])
     assert "nonlocal SBT, ε = 0.001" in fig.axes[1].get_title()
     with pytest.raises(ValueError, match="mixes models"):
-        plots.phase_diagram(pd.concat([local.assign(model="local", slenderness=np.nan),
+        figures.phase_diagram(pd.concat([local.assign(model="local", slenderness=np.nan),
                                        nonlocal_table]))
 
 
 def test_phase_diagram_paper_band_adds_the_two_empirical_curves():
     frame = table()
-    plain = plots.phase_diagram(frame)
-    banded = plots.phase_diagram(frame, paper_band=True)
+    plain = figures.phase_diagram(frame)
+    banded = figures.phase_diagram(frame, paper_band=True)
     assert len(banded.axes[0].get_lines()) == len(plain.axes[0].get_lines()) + 2
     theta, g0 = banded.axes[0].get_lines()[-1].get_data()
-    assert np.allclose(g0 * np.sin(np.radians(theta)) / 3, plots.PAPER_BAND[1])
+    assert np.allclose(g0 * np.sin(np.radians(theta)) / 3, figures.PAPER_BAND[1])
 
 
 def test_phase_diagram_draws_failed_cases_resolved_or_not():
     frame = table().assign(resolved=False)
-    failed = [c for c in plots.phase_diagram(frame).axes[0].collections if c.get_label() == "failed"]
+    failed = [c for c in figures.phase_diagram(frame).axes[0].collections if c.get_label() == "failed"]
     assert len(failed) == 1 and len(failed[0].get_offsets()) == (frame["regime"] == "failed").sum()
 
 
@@ -364,7 +364,7 @@ def test_plot_trajectory_script_draws_the_loop_near_its_centroid(tiny, tmp_path,
     """scripts/plot_trajectory.py centres each snapshot on its centre of mass: the loop
     fell ~65 per unit time, yet every drawn point lies within 3 radii of the centroid."""
     drawn = {}
-    monkeypatch.setattr(plots, "save", lambda fig, path, dpi=200: drawn.setdefault("fig", fig))
+    monkeypatch.setattr(figures, "save", lambda fig, path, dpi=200: drawn.setdefault("fig", fig))
     script = runpy.run_path(os.path.join(ROOT, "scripts", "plot_trajectory.py"))
     script["main"](str(tiny / "run.parquet"), str(tmp_path / "t.png"))
     lines = drawn["fig"].axes[0].get_lines()
@@ -379,9 +379,9 @@ def test_undetermined_rows_are_ringed_in_the_phase_diagram_and_figs_7_8():
     frame = table()
     assert "determined" in frame and frame["determined"].notna().all()
     labels = lambda fig: [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
-    assert not any("not determined" in text for text in labels(plots.phase_diagram(frame)))
+    assert not any("not determined" in text for text in labels(figures.phase_diagram(frame)))
     frame = frame.assign(determined=[False] + [True] * (len(frame) - 1))
-    fig = plots.phase_diagram(frame)
+    fig = figures.phase_diagram(frame)
     assert sum("not determined" in text for text in labels(fig)) == 1
     rings = [c for c in fig.axes[0].collections if c.get_label().startswith("not determined")]
     assert len(rings) == 1 and len(rings[0].get_offsets()) == 1
@@ -393,9 +393,9 @@ def test_undetermined_rows_are_ringed_in_the_phase_diagram_and_figs_7_8():
 # ---- scripts/make_figures.py ---------------------------------------------------------
 def test_make_figures_quick_draws_every_committed_figure(tmp_path):
     """``scripts/make_figures.py --quick`` runs every step on tiny inputs and draws every
-    PNG of docs/figures/: the one command covers the committed figures."""
+    PNG, GIF and HTML page of docs/figures/: the one command covers the committed figures."""
     committed = sorted(name for name in os.listdir(os.path.join(ROOT, "docs", "figures"))
-                       if name.endswith(".png"))
+                       if name.endswith((".png", ".gif", ".html")))
     out = tmp_path / "figures"
     done = subprocess.run(
         [sys.executable, os.path.join("scripts", "make_figures.py"), "--quick", "--threads", "1",

@@ -22,7 +22,7 @@ def test_cache_directory_follows_the_source(tmp_path):
         assert any(p.endswith("loopsim/" + module) for p in sources), module
     # orchestration that no kernel imports does not invalidate the compiled kernels
     for module in ("cli/__init__.py", "cli/sweep.py", "ensemble.py", "sweeps/runner.py",
-                   "plots.py"):
+                   "figures/phase.py"):
         assert not any(p.endswith("loopsim/" + module) for p in sources), module
 
 

@@ -163,19 +163,19 @@ def test_trajectory_plot_is_centred_on_the_loop(tmp_path):
     import matplotlib
     matplotlib.use("Agg")
     import pyarrow.parquet as pq
-    from loopsim import plots
+    from loopsim import figures
 
     path = tmp_path / "run.parquet"
     assert main(["run", "--g0", "60", "--theta0", "30", "--t-end", "10", "--snapshots", "5",
                  "--out", str(path)]) == 0
     frame = pq.read_table(path).to_pandas()
     assert np.asarray(frame["x"].iloc[-1])[2 * 13] < -100  # z's mean coefficient: it fell
-    fig = plots.trajectory(frame, 6)
+    fig = figures.trajectory(frame, 6)
     lines = fig.axes[0].get_lines()
     assert len(lines) == 5
     extent = max(np.abs(line.get_xydata()).max() for line in lines)
     assert 0.5 < extent < 3.0  # unit radius, loop length 2π
-    plots.save(fig, tmp_path / "run.png")
+    figures.save(fig, tmp_path / "run.png")
     assert (tmp_path / "run.png").stat().st_size > 0
 
 

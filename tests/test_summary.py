@@ -121,7 +121,7 @@ def test_compare_command_on_two_sweeps(tmp_path, capsys):
 def test_summary_figures_draw_every_cell():
     import matplotlib
     matplotlib.use("Agg")
-    from loopsim import plots
+    from loopsim import figures
 
     rows = []
     for g0 in (30.0, 150.0):
@@ -136,7 +136,7 @@ def test_summary_figures_draw_every_cell():
                                  wall_s=0.1, q_final=g0 / 10 + seed))
     frame = pd.DataFrame(rows)
     cells = summary.summarize(frame)
-    fig = plots.probability_phase_diagram(cells, style="colour")
+    fig = figures.probability_phase_diagram(cells, style="colour")
     colours = fig.axes[0].collections[0]
     assert len(colours.get_offsets()) == 4
     np.testing.assert_allclose(colours.get_array(), cells["p_3d"])
@@ -144,21 +144,21 @@ def test_summary_figures_draw_every_cell():
     assert len(rings) == 1 and len(rings[0].get_offsets()) == 2
     assert sorted(t.get_text() for t in fig.axes[0].texts) == ["0.25", "0.25"]
     # as pies: one wedge per regime a cell reaches, clockwise from the top, filling it
-    fig = plots.probability_phase_diagram(cells)
+    fig = figures.probability_phase_diagram(cells)
     wedges = [c for c in fig.axes[0].collections if c.get_label() != "some seeds not determined"
               and len(c.get_offsets()) == 1]
     assert len(wedges) == 1 + 1 + 2 + 2
     assert sorted(c.get_label() for c in fig.axes[0].collections
                   if not len(c.get_offsets())) == ["3D", "in-plane", "stable"]  # the legend
-    verts, scale = plots.wedge_marker(0.0, np.pi / 2)
+    verts, scale = figures.wedge_marker(0.0, np.pi / 2)
     assert scale == pytest.approx(1.0) and np.allclose(verts[1], [1, 0]) and np.allclose(
         verts[-2], [0, 1])
-    _, scale = plots.wedge_marker(np.pi / 4 - 0.1, np.pi / 4 + 0.1)
+    _, scale = figures.wedge_marker(np.pi / 4 - 0.1, np.pi / 4 + 0.1)
     assert scale == pytest.approx(np.cos(np.pi / 4 - 0.1) ** 2)  # the marker's rescaling undone
     assert fig.axes[0].get_title() == "regime probabilities per cell over 4 seeds"
     with pytest.raises(ValueError, match="style must be"):
-        plots.probability_phase_diagram(cells, style="bars")
-    fig = plots.tilt_distribution(cells, frame)
+        figures.probability_phase_diagram(cells, style="bars")
+    fig = figures.tilt_distribution(cells, frame)
     assert len(fig.axes[0].collections[0].get_offsets()) == len(frame)  # every seed, faint
     # Fig. 8 as distributions: one median per cell at its median terminal q, every seed
     # faint, over the steady branch drawn solid where stable, dashed where not
@@ -167,14 +167,14 @@ def test_summary_figures_draw_every_cell():
     branch = pd.DataFrame(dict(q=[0.0, 5.0, 10.0], aspect_ratio=[1.0, 1.5, 2.0],
                                stable_in_plane=[True, True, False],
                                stable_out_of_plane=[True, True, True]))
-    fig = plots.aspect_distribution(cells, frame, branch=branch)
+    fig = figures.aspect_distribution(cells, frame, branch=branch)
     ax = fig.axes[0]
     assert len(ax.collections[0].get_offsets()) == len(frame)
     medians = [line for line in ax.lines if line.get_marker() == "o"]
     assert len(medians) == 1 and list(medians[0].get_xdata()) == list(cells["q_final_median"])
     assert {line.get_linestyle() for line in ax.lines if line.get_label().startswith(
         "steady shapes")} == {"-", "--"}
-    fig = plots.distribution_summary(cells, frame, branch=branch)
+    fig = figures.distribution_summary(cells, frame, branch=branch)
     assert [a.get_title() for a in fig.axes[:3]][1:] == ["terminal tilt over seeds",
                                                         "terminal shape over seeds"]
 

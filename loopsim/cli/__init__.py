@@ -5,9 +5,9 @@ exit status 2; a run that fails numerically exits 1 after printing its summary; 
 machine refusing to go on (disk full, read-only filesystem, I/O error) exits 3.
 
 One module per command (``run``, ``sweep``, ``stability``, ``summary``, ``compare``,
-``branch``, ``figures``), each with its ``add_parser`` (its options) and ``command``
-(its work); ``common`` holds what they share.  Modules load nothing heavy until a
-command runs: ``loopsim --help`` imports neither NumPy nor Numba.
+``branch``, ``figures``, ``report``, ``animate``), each with its ``add_parser`` (its
+options) and ``command`` (its work); ``common`` holds what they share.  Modules load
+nothing heavy until a command runs: ``loopsim --help`` imports neither NumPy nor Numba.
 """
 import argparse
 import contextlib
@@ -16,14 +16,15 @@ import warnings
 
 from .._version import __version__
 from ..config import ENVIRONMENT_ERRNOS
-from . import branch, compare, figures, run, stability, summary, sweep
+from . import animate, branch, compare, figures, report, run, stability, summary, sweep
 from .common import EXIT_ENVIRONMENT, EXIT_FAILED_RUN, EXIT_USAGE, METHODS, Parser
 
 __all__ = ["EXIT_ENVIRONMENT", "EXIT_FAILED_RUN", "EXIT_USAGE", "METHODS", "main"]
 
 #: The commands, in the order ``loopsim --help`` lists them.
 COMMANDS = {"run": run, "sweep": sweep, "stability": stability, "summary": summary,
-            "compare": compare, "branch": branch, "figures": figures}
+            "compare": compare, "branch": branch, "figures": figures, "report": report,
+            "animate": animate}
 
 
 def _build_parser():

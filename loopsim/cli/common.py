@@ -175,16 +175,16 @@ def steady_branch_to(q_max):
 
 
 def save_distribution_figure(table, frame, path):
-    """Draw a summary table and its rows (``plots.distribution_summary``) to ``path``:
+    """Draw a summary table and its rows (``figures.distribution_summary``) to ``path``:
     for the local model over its steady branch up to the largest terminal q seen,
     rounded up to a multiple of 5 (at most :data:`BRANCH_Q_MAX`)."""
-    from .. import plots
+    from .. import figures
 
     use_agg()
     branch = None
     q_final = frame["q_final"].to_numpy(float) if "q_final" in frame else []
     q_seen = [float(q) for q in q_final if q == q]
-    if plots.frame_model(frame).name == "local" and q_seen:
+    if figures.frame_model(frame).name == "local" and q_seen:
         branch = steady_branch_to(min(BRANCH_Q_MAX, 5.0 * math.ceil(1.05 * max(q_seen) / 5.0)
                                       or 5.0))
-    plots.save(plots.distribution_summary(table, frame, branch=branch), path, dpi=150)
+    figures.save(figures.distribution_summary(table, frame, branch=branch), path, dpi=150)

@@ -51,7 +51,7 @@ FULL_ONLY = ("n", "theta0", "w", "q_scan", "g0", "top", "onset", "figure", "slen
 
 
 def _cmd_stability_full(args):
-    from .. import models, plots, sweeps, validation
+    from .. import figures, models, sweeps, validation
     from ..stability import circle, onset, paper
 
     if args.figure is not None:
@@ -108,7 +108,7 @@ def _cmd_stability_full(args):
                 eps, t_end, detect, args.n, s, args.theta0, **full)) for s in circle.SECTORS}}
     if args.figure:
         use_agg()
-        plots.save(plots.growth_rates(args.n, theta0_deg=args.theta0, **full), args.figure,
+        figures.save(figures.growth_rates(args.n, theta0_deg=args.theta0, **full), args.figure,
                    dpi=120)
         out["figure"] = args.figure
     if args.json:

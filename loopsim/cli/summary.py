@@ -36,10 +36,10 @@ def command(args):
     frame = io.read_results(args.sweep_dir)
     table = summary.summarize(frame, seed=args.seed)
     if args.figure is not None:  # refused before anything is written
-        from .. import plots
+        from .. import figures
 
-        plots.frame_model(frame)
-        plots.check_one_cell_per_point(table)
+        figures.frame_model(frame)
+        figures.check_one_cell_per_point(table)
     shown = [c for c in table.columns if c in summary.CELL_INPUTS] + [
         "seeds", "determined", "p_stable", "p_in_plane", "p_3d", "p_3d_low", "p_3d_high",
         "tilt_median", "tilt_median_low", "tilt_median_high"]

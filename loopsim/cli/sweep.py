@@ -222,7 +222,7 @@ def _check_rerun_options(args):
 def command(args):
     import numba
 
-    from .. import plots, sweeps, validation
+    from .. import figures, sweeps, validation
 
     if args.figure is not None:
         validation.check_output_file("--figure", args.figure)
@@ -272,30 +272,31 @@ def command(args):
                 if hasattr(stopped, "done") else "")
         return interrupted(getattr(stopped, "signum", 2),
                             f"{done}re-run the same command to resume")
-    counts = frame["regime"].value_counts().to_dict()
-    print(f"{len(frame)} cases in {out}: "
-          + ", ".join(f"{k} {v}" for k, v in sorted(counts.items())))
-    unresolved = frame[~frame["resolved"]]
-    if len(unresolved):
-        print(f"{len(unresolved)} of {len(frame)} cases NOT resolved at their n (transient length "
-              f"error > {config.thresholds.resolved_length_error:g} or spectral tail along the "
-              f"run > {config.thresholds.resolved_tail:g}; column 'resolved'): their "
-              f"terminal tilt and shape are not converged; " + refinement_advice(config, unresolved)
+    from .. import summary
+
+    counts = summary.outcome_counts(frame)
+    print(f"{counts['cases']} cases in {out}: "
+          + ", ".join(f"{k} {v}" for k, v in counts["regimes"].items()))
+    if counts["unresolved"]:
+        print(f"{counts['unresolved']} of {counts['cases']} cases NOT resolved at their n "
+              f"(transient length error > {config.thresholds.resolved_length_error:g} or "
+              f"spectral tail along the run > {config.thresholds.resolved_tail:g}; column "
+              f"'resolved'): their terminal tilt and shape are not converged; "
+              + refinement_advice(config, frame[~frame["resolved"]])
               + " (regimes among them: " + ", ".join(
-                  f"{k} {v}" for k, v in sorted(unresolved["regime"].value_counts().items())) + ")")
-    undetermined = frame[frame["determined"].eq(False)]
-    if len(undetermined):
-        print(f"{len(undetermined)} of {len(frame)} cases NOT determined (a twin at 10x "
-              "stricter tolerances ends elsewhere; column 'determined'): their terminal tilt "
-              "is a sample of an ill-conditioned transient, not an outcome (regimes among "
-              "them: " + ", ".join(f"{k} {v}" for k, v in
-                                   sorted(undetermined["regime"].value_counts().items())) + ")")
+                  f"{k} {v}" for k, v in counts["unresolved_regimes"].items()) + ")")
+    if counts["undetermined"]:
+        print(f"{counts['undetermined']} of {counts['cases']} cases NOT determined (a twin at "
+              "10x stricter tolerances ends elsewhere; column 'determined'): their terminal "
+              "tilt is a sample of an ill-conditioned transient, not an outcome (regimes "
+              "among them: " + ", ".join(
+                  f"{k} {v}" for k, v in counts["undetermined_regimes"].items()) + ")")
     seeds_auto = args.rerun_failed is None and args.seeds == "auto"
     if seeds_auto:
-        reasons = stops["stop_reason"].value_counts().to_dict()
-        print(f"{len(stops)} points, seeds until sharp: " + ", ".join(
-            f"{k} {v}" for k, v in sorted(reasons.items()))
-            + f" (seeds per point {stops['seeds'].min()}-{stops['seeds'].max()}; why each "
+        stopped = summary.stop_counts(stops)
+        print(f"{stopped['points']} points, seeds until sharp: " + ", ".join(
+            f"{k} {v}" for k, v in stopped["reasons"].items())
+            + f" (seeds per point {stopped['seeds_min']}-{stopped['seeds_max']}; why each "
             f"stopped: {out}/seeds_auto.parquet; per point: loopsim summary {out})")
         sampled = stops[stops["runs"] == "samples"] if "runs" in stops else stops.iloc[:0]
         checked = sampled[sampled["check_seeds"] > 0]
@@ -310,16 +311,13 @@ def command(args):
     if args.figure:
         use_agg()
         if seeds_auto:
-            from .. import summary
-
             save_distribution_figure(summary.summarize(frame), frame, args.figure)
         else:
-            plots.save(plots.phase_diagram(frame), args.figure)
+            figures.save(figures.phase_diagram(frame), args.figure)
         print(f"{'distribution summary' if seeds_auto else 'phase diagram'}: {args.figure}")
-    failed = int((frame["status"] != "ok").sum())
-    if failed:
-        print(f"{failed} of {len(frame)} cases failed (column 'status'); exit status "
-              f"{EXIT_FAILED_RUN}; rerun them with: loopsim sweep --rerun-failed {out} "
-              "--method radau5 (or another --rtol)", file=sys.stderr)
+    if counts["failed"]:
+        print(f"{counts['failed']} of {counts['cases']} cases failed (column 'status'); exit "
+              f"status {EXIT_FAILED_RUN}; rerun them with: "
+              f"{summary.RERUN_COMMAND.format(out=out)} (or another --rtol)", file=sys.stderr)
         return EXIT_FAILED_RUN
     return 0

@@ -14,7 +14,7 @@ as DataFrames, so every function can be drawn from stored numbers:
 * Fig. 3  :func:`stability_data`, :func:`stability` - growth rates against q and
   critical q against n: the paper's operator beside the full linearisation;
 * Fig. 4  :func:`gallery` - terminal shapes at one θ0 across g0;
-* Fig. 5  ``plots.phase_diagram(frame, paper_band=True)``;
+* Fig. 5  :func:`phase_diagram` (``paper_band=True``);
 * Fig. 6  :func:`evolution` - one trajectory: 3D, side and top views;
   :func:`evolution_rows` - several, one row each, on one time scale;
 * Fig. 7  :func:`q_and_tilt` - q_final against q0, θ_final against θ0;
@@ -22,29 +22,42 @@ as DataFrames, so every function can be drawn from stored numbers:
   steady branch (``stability.branch.steady_branch``) when given;
 * Fig. 9  :func:`phase_diagrams` - phase diagrams of several sweeps side by side;
 * :func:`seed_distributions` - terminal tilt and aspect ratio over seeds;
+* :func:`probability_phase_diagram`, :func:`tilt_distribution`,
+  :func:`aspect_distribution`, :func:`distribution_summary` - a seed sweep's summary
+  table (``loopsim.summarize``) drawn as distributions;
+* :func:`growth_rates`, :func:`nonlocal_thresholds`, :func:`model_outcomes` - the
+  linearisation of the circle, the nonlocal model beside the local one;
+* :func:`trajectory` - one run's snapshots, face-on, with tilt and aspect ratio;
+* :func:`save` - write a figure atomically;
+* :func:`animate` - a GIF or MP4 of one run (``loopsim animate``, module ``animation``);
 * :func:`write_figures` - all of them from files (``loopsim figures``).
 
-The modules: ``style`` (shared helpers and styles), ``gallery`` (Fig. 4),
-``evolution`` (Figs. 6 and 1), ``terminal`` (Figs. 7, 8, seeds), ``phase``
-(Figs. 5, 9), ``linear`` (Fig. 3, the steady branch), ``suite`` (files to PNGs).
-Regime colours are ``plots.REGIME_STYLE`` (the paper's: stable dark purple,
+The modules: ``style`` (shared helpers and styles, :func:`save`), ``gallery`` (Fig. 4),
+``evolution`` (Figs. 6 and 1, a run's trajectory), ``terminal`` (Figs. 7, 8, seeds),
+``phase`` (Figs. 5, 9), ``linear`` (Fig. 3, the steady branch), ``nonlocal_sbt`` (the
+nonlocal model), ``distributions`` (summary tables over seeds), ``suite`` (files to PNGs).
+Regime colours are :data:`REGIME_STYLE` (the paper's: stable dark purple,
 in-plane green-blue, 3D yellow); cases not resolved at their n are hollow.
 """
 from .. import diagnostics, spectral, validation  # noqa: F401  (names of the former module)
-from ..plots import (
-    PAPER_BAND, REGIME_STYLE, mark_undetermined, order_column, orders_text, phase_diagram,
-)
 from ..stability import circle, paper  # noqa: F401  (names of the former module)
+from .animation import animate, animation_figure, frame_indices, load_trajectory, write_animation
+from .distributions import (
+    aspect_distribution, check_one_cell_per_point, distribution_summary, probability_phase_diagram,
+    regime_pies, tilt_distribution, wedge_marker,
+)
 from .evolution import (
     evolution, evolution_rows, settling_index, snapshot_indices, tension_figure, tension_on_shape,
-    time_colours,
+    time_colours, trajectory,
 )
 from .gallery import gallery, plane_view, side_view_basis, unit_circle
-from .linear import load_branch, stability, stability_data
-from .phase import phase_diagrams
+from .linear import branch_lines, growth_rates, load_branch, stability, stability_data
+from .nonlocal_sbt import model_outcomes, nonlocal_thresholds
+from .phase import phase_diagram, phase_diagrams
 from .style import (
-    ASPECT_LABEL, CURVE_POINTS, TIME_CMAP, centred_curve, coefficients, default_thresholds,
-    merged_legend_entries, new_figure, q_lines, regime_key, regime_style, resolved_mask,
+    ASPECT_LABEL, CURVE_POINTS, PAPER_BAND, REGIME_STYLE, TIME_CMAP, centred_curve, coefficients,
+    default_thresholds, frame_model, mark_undetermined, merged_legend_entries, model_text,
+    new_figure, order_column, orders_text, q_lines, regime_key, regime_style, resolved_mask, save,
     scatter_regimes, single_axes,
 )
 from .suite import (
@@ -54,12 +67,16 @@ from .terminal import aspect_ratio, q_and_tilt, seed_distributions
 
 __all__ = [
     "ASPECT_LABEL", "CURVE_POINTS", "FIGURE_NAMES", "PAPER_BAND", "REGIME_STYLE", "TIME_CMAP",
-    "aspect_ratio", "centred_curve", "coefficients", "default_thresholds", "evolution",
-    "evolution_rows", "gallery", "load_branch", "mark_undetermined", "merged_legend_entries",
-    "new_figure",
-    "order_column", "orders_text", "phase_diagram", "phase_diagrams", "plane_view", "q_and_tilt",
-    "q_lines", "read_run", "read_sweep", "regime_key", "regime_style", "resolved_mask",
-    "run_title", "scatter_regimes", "seed_distributions", "settling_index", "side_view_basis",
-    "single_axes", "snapshot_indices", "stability", "stability_data", "sweep_kind", "sweep_label",
-    "tension_figure", "tension_on_shape", "time_colours", "unit_circle", "write_figures",
+    "animate", "animation_figure", "frame_indices", "load_trajectory", "write_animation",
+    "aspect_distribution", "aspect_ratio", "branch_lines", "centred_curve",
+    "check_one_cell_per_point", "coefficients", "default_thresholds", "distribution_summary",
+    "evolution", "evolution_rows", "frame_model", "gallery", "growth_rates", "load_branch",
+    "mark_undetermined", "merged_legend_entries", "model_outcomes", "model_text", "new_figure",
+    "nonlocal_thresholds", "order_column", "orders_text", "phase_diagram", "phase_diagrams",
+    "plane_view", "probability_phase_diagram", "q_and_tilt", "q_lines", "read_run", "read_sweep",
+    "regime_key", "regime_pies", "regime_style", "resolved_mask", "run_title", "save",
+    "scatter_regimes", "seed_distributions", "settling_index", "side_view_basis", "single_axes",
+    "snapshot_indices", "stability", "stability_data", "sweep_kind", "sweep_label",
+    "tension_figure", "tension_on_shape", "tilt_distribution", "time_colours", "trajectory",
+    "unit_circle", "wedge_marker", "write_figures",
 ]

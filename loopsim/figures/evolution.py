@@ -162,3 +162,40 @@ def tension_figure(trajectory, rows=(0, -1), title=""):
         tension_on_shape(x, np.asarray(row["multiplier"], float), ax=ax,
                          title=f"{title}t = {row['t']:.3g}")
     return fig
+
+
+def trajectory(frame, n, title="", axes=None):
+    """Snapshots of one run (a trajectory table: columns t, x, theta_deg, aspect_ratio):
+    left, the loop seen face-on (each snapshot, centred on its centre of mass, projected
+    on the plane of the last snapshot's two largest principal axes) and coloured by time,
+    with a colour bar; right, tilt and aspect ratio against time.  ``axes``: a pair, or
+    None."""
+    if axes is None:
+        fig, axes = plt.subplots(1, 2, figsize=(9.6, 3.9), constrained_layout=True)
+    ax_shape, ax_time = axes
+    s = np.linspace(0.0, 2.0 * np.pi, 200)
+    times = frame["t"].to_numpy(float)
+    cmap = plt.get_cmap("viridis_r")  # light yellow first, dark purple last (as the paper)
+    norm = Normalize(vmin=times.min(), vmax=times.max() if times.max() > times.min() else times.min() + 1)
+    shapes = [np.array(c, dtype=float).reshape(3, 2 * n + 1) for c in frame["x"]]
+    _, vectors = diagnostics.principal_axes(shapes[-1])
+    major, minor = vectors[:, 2], vectors[:, 1]
+    for t, x in zip(times, shapes):
+        x[:, 0] = 0.0  # centred: the mean coefficient is the centre of mass
+        points = spectral.evaluate(x, s)
+        ax_shape.plot(major @ points, minor @ points, color=cmap(norm(t)), lw=1)
+    ax_shape.set(xlabel="along the major axis", ylabel="along the minor axis",
+                 aspect="equal", title=(title + "\n" if title else "")
+                 + "face-on (the last shape's principal plane)")
+    ax_shape.title.set_fontsize(10)
+    ax_shape.figure.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax_shape,
+                             label="time t", shrink=0.9)
+    ax_time.plot(frame["t"], frame["theta_deg"], color="C0")
+    ax_ratio = ax_time.twinx()
+    ax_ratio.plot(frame["t"], frame["aspect_ratio"], color="C1")
+    ax_time.set_xlabel("time t")
+    ax_time.set_ylabel("tilt θ (deg)", color="C0")
+    ax_ratio.set_ylabel("aspect ratio (variance along the\nmajor / minor principal axis)",
+                        color="C1")
+    ax_time.set_title("tilt (blue) and aspect ratio (orange) against time", fontsize=10)
+    return ax_shape.figure

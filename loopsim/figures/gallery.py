@@ -3,8 +3,10 @@ import numpy as np
 from matplotlib.lines import Line2D
 
 from .. import diagnostics
-from ..plots import order_column, orders_text
-from .style import centred_curve, coefficients, new_figure, regime_key, regime_style, resolved_mask
+from .style import (
+    centred_curve, coefficients, new_figure, order_column, orders_text, regime_key, regime_style,
+    resolved_mask,
+)
 
 
 def side_view_basis(x):

@@ -1,16 +1,86 @@
 """Shared style and helpers of the figure modules: axes grids, curves, regime scatter, q lines.
 
-Regime colours are ``plots.REGIME_STYLE`` (the paper's: stable dark purple, in-plane
+Regime colours are :data:`REGIME_STYLE` (the paper's: stable dark purple, in-plane
 green-blue, 3D yellow); cases not resolved at their n are drawn hollow, cases not
 determined (a stricter twin ends elsewhere) ringed red.
 """
+import os
+
 import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.lines import Line2D
 
-from .. import spectral
-from ..plots import PAPER_BAND, REGIME_STYLE, mark_undetermined
+from .. import models, spectral
 from ..stability import circle, paper
+
+REGIME_STYLE = {
+    "stable": dict(color="#3b0f70", marker="o", label="stable"),
+    "in-plane": dict(color="#21918c", marker="s", label="in-plane"),
+    "3d": dict(color="#f0c419", marker="^", label="3D"),
+    "failed": dict(color="#d62728", marker="x", label="failed"),
+}
+
+
+def order_column(frame):
+    """The column holding each row's truncation order: ``n_used`` (the order its terminal
+    coefficients are at; with ``--n auto`` the highest reached) when present, else ``n``."""
+    return "n_used" if "n_used" in frame and frame["n_used"].notna().all() else "n"
+
+
+def orders_text(frame):
+    """'n = 6' for a fixed-n table, 'n auto (n_used = 12, 16)' for ``--n auto`` rows."""
+    column = order_column(frame)
+    values = ", ".join(str(int(v)) for v in sorted(frame[column].unique()))
+    config = (frame.attrs.get("loopsim", {}) or {}).get("sweep_config", {}) or {}
+    auto = bool(config.get("n_auto")) or (column == "n_used" and bool((frame["n_used"] != frame["n"]).any()))
+    return f"n auto (n_used = {values})" if auto else f"n = {values}"
+
+
+def frame_model(frame):
+    """The ``models.Model`` of a results table's rows (local for a table without the
+    column); ValueError for a table mixing models (one diagram, one model)."""
+    if "model" not in frame or not len(frame):
+        return models.LOCAL
+    pairs = {(m, None if m == "local" else float(e))
+             for m, e in zip(frame["model"], frame["slenderness"])}
+    if len(pairs) > 1:
+        raise ValueError(f"the table mixes models {sorted(pairs, key=str)}: draw one at a time")
+    return models.choose(*pairs.pop())
+
+
+def model_text(model):
+    """'' for the local model, ', nonlocal SBT, ε = 0.001' for the nonlocal one."""
+    return "" if model.name == "local" else f", nonlocal SBT, ε = {model.slenderness:g}"
+
+
+def mark_undetermined(ax, frame, xcol, ycol, size=22, shift=0.0):
+    """Ring the rows whose outcome is not determined (``determined`` False: a twin at
+    stricter tolerances ends elsewhere, ``loopsim.outcomes``) in red, one legend entry."""
+    if "determined" not in frame:
+        return
+    rows = frame[frame["determined"].eq(False).to_numpy()]
+    if len(rows):
+        ax.scatter(rows[xcol] + shift, rows[ycol], s=3.2 * size, marker="o", facecolors="none",
+                   edgecolors="#d62728", linewidths=0.9, zorder=4,
+                   label="not determined (twin\nends elsewhere)")
+
+
+#: The paper's empirical edges of the in-plane regime (§6, Figs. 5, 7 and 9), q = g0 sin θ0 / 3.
+PAPER_BAND = (10.5, 18.5)
+
+
+def save(fig, path, dpi=200):
+    """Write ``fig`` to ``path`` (its directory made if absent; atomically: a failed write
+    leaves no file) and close it."""
+    from .. import io
+
+    try:
+        io.write_file_atomically(path, lambda tmp: fig.savefig(
+            tmp, dpi=dpi, format=os.path.splitext(path)[1][1:] or None))
+    finally:
+        plt.close(fig)
+    return path
+
 
 #: Colour map of time in trajectories: light yellow (start) to dark purple (end), as the
 #: paper's Fig. 6.
@@ -58,7 +128,7 @@ def centred_curve(x, points=CURVE_POINTS):
 
 
 def regime_style(regime):
-    """The ``plots.REGIME_STYLE`` entry of a regime (that of "failed" for anything else)."""
+    """The :data:`REGIME_STYLE` entry of a regime (that of "failed" for anything else)."""
     return REGIME_STYLE.get(regime, REGIME_STYLE["failed"])
 
 
@@ -77,7 +147,7 @@ def regime_key(regimes, lw=2.0):
 
 def scatter_regimes(ax, frame, xcol, ycol, shift=None, size=20, label_suffix=""):
     """Scatter by regime, resolved filled and unresolved hollow, undetermined ringed red
-    (``plots.mark_undetermined``); ``shift``: {regime: dx}."""
+    (:func:`mark_undetermined`); ``shift``: {regime: dx}."""
     resolved = resolved_mask(frame)
     shifted = frame.assign(**{xcol: frame[xcol] + frame["regime"].map(shift or {}).fillna(0.0)})
     mark_undetermined(ax, shifted, xcol, ycol, size)

@@ -5,11 +5,11 @@ import numpy as np
 import pandas as pd
 
 from .. import validation
-from ..plots import orders_text, phase_diagram, save as save_figure
 from .evolution import evolution, evolution_rows, tension_figure
 from .gallery import gallery
 from .linear import load_branch, stability, stability_data
-from .phase import phase_diagrams
+from .phase import phase_diagram, phase_diagrams
+from .style import orders_text, save as save_figure
 from .terminal import aspect_ratio, q_and_tilt, seed_distributions
 
 #: Figure names of :func:`write_figures` (``--only``), in drawing order.

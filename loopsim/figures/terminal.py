@@ -2,9 +2,10 @@
 import numpy as np
 from matplotlib.ticker import MaxNLocator
 
-from ..plots import branch_lines, order_column, orders_text
+from .linear import branch_lines
 from .style import (
-    ASPECT_LABEL, default_thresholds, new_figure, q_lines, scatter_regimes, single_axes,
+    ASPECT_LABEL, default_thresholds, new_figure, order_column, orders_text, q_lines,
+    scatter_regimes, single_axes,
 )
 
 

@@ -2,6 +2,9 @@
 every table carries, a run's trajectory table, and reading a file's metadata back."""
 import datetime
 import json
+import os
+import platform
+import socket
 
 import numba
 import numpy as np
@@ -62,6 +65,11 @@ def coefficients(row):
     return np.asarray(values, dtype=float).reshape(3, -1)
 
 
+def machine():
+    """The machine a table is written on, as one line: host name, platform, CPU count."""
+    return f"{socket.gethostname()} ({platform.platform()}, {os.cpu_count()} CPUs)"
+
+
 def provenance(**extra):
     """Schema-level metadata common to every table loopsim writes."""
     meta = {
@@ -70,6 +78,7 @@ def provenance(**extra):
         "numpy_version": np.__version__,
         "pyarrow_version": pa.__version__,
         "created_utc": datetime.datetime.now(datetime.timezone.utc).isoformat(),
+        "machine": machine(),
         "coefficient_layout": COEFFICIENT_LAYOUT,
     }
     meta.update(extra)

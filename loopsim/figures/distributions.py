@@ -1,0 +1,175 @@
+"""Outcomes over seeds as distributions: regime probabilities per cell, terminal tilt and
+aspect ratio with their medians and intervals (tables of ``loopsim.summarize``)."""
+import matplotlib.pyplot as plt
+import numpy as np
+
+from ..stability import circle
+from .linear import branch_lines
+from .style import REGIME_STYLE, single_axes
+
+
+def wedge_marker(start, stop, points=24):
+    """A pie wedge from angle ``start`` to ``stop`` (radians, counter-clockwise) as a
+    scatter marker, and the factor its size must be scaled by: matplotlib rescales a
+    marker's vertices to its largest coordinate, so a narrow wedge would grow."""
+    angles = np.linspace(start, stop, max(2, int(points * (stop - start) / np.pi) + 2))
+    verts = np.vstack([[0.0, 0.0], np.column_stack([np.cos(angles), np.sin(angles)]),
+                       [0.0, 0.0]])
+    return verts, float(np.abs(verts).max()) ** 2
+
+
+def regime_pies(cells, ax, size=150):
+    """Each cell of a summary table at (θ0, g0) as a pie of its regime probabilities
+    (``p_stable``, ``p_in_plane``, ``p_3d``, ``p_failed``), clockwise from the top, in
+    the regime colours of :data:`REGIME_STYLE`."""
+    reached = set()
+    for _, cell in cells.iterrows():
+        start = np.pi / 2
+        for regime, style in REGIME_STYLE.items():
+            share = float(cell.get(f"p_{regime.replace('-', '_')}", 0.0) or 0.0)
+            if share <= 0.0:
+                continue
+            stop = start - 2 * np.pi * share
+            verts, scale = wedge_marker(stop, start)
+            ax.scatter([cell["theta0_deg"]], [cell["g0"]], marker=verts, s=size * scale,
+                       color=style["color"], edgecolors="none", zorder=3)
+            reached.add(regime)
+            start = stop
+    for regime in (r for r in REGIME_STYLE if r in reached):  # legend entries: whole discs
+        ax.scatter([], [], marker="o", s=size / 2, color=REGIME_STYLE[regime]["color"],
+                   label=REGIME_STYLE[regime]["label"])
+
+
+def check_one_cell_per_point(cells):
+    """ValueError naming the first (g0, θ0) that holds several cells of a summary table
+    (they differ in another input, say the model or rtol): a diagram over (θ0, g0) would
+    draw them on top of each other.  Returns ``cells``."""
+    repeated = cells[cells.duplicated(["g0", "theta0_deg"], keep=False)]
+    if len(repeated):
+        first = repeated.iloc[0]
+        others = [c for c in cells.attrs.get("loopsim_summary", {}).get("cells_by", [])
+                  if c not in ("g0", "theta0_deg")]
+        count = int(((cells["g0"] == first["g0"])
+                     & (cells["theta0_deg"] == first["theta0_deg"])).sum())
+        raise ValueError(f"the summary has {count} cells at g0 = {first['g0']:g}, theta0 = {first['theta0_deg']:g} "
+                         f"(they differ in {', '.join(others) or 'another input'}): one "
+                         "diagram draws one cell per point; filter the rows and draw each apart")
+    return cells
+
+
+def probability_phase_diagram(cells, frame=None, ax=None, style="pie"):
+    """The phase diagram read as probabilities: each cell of a summary table
+    (``loopsim.summarize``) at (θ0, g0) as a pie of its regime probabilities
+    (``style="pie"``, :func:`regime_pies`) or coloured by its probability of ending 3D
+    (``style="colour"``, labelled with P(in-plane) when it is neither 0 nor 1); ringed
+    red where any seed is not determined; with the full linearisation's thresholds
+    (``q_c`` at n = 16)."""
+    if style not in ("pie", "colour"):
+        raise ValueError(f"style must be 'pie' or 'colour', got {style!r}")
+    check_one_cell_per_point(cells)
+    fig, ax = single_axes(ax, (6.8, 4.0))
+    if style == "pie":
+        regime_pies(cells, ax)
+    else:
+        points = ax.scatter(cells["theta0_deg"], cells["g0"], c=cells["p_3d"],
+                            cmap="viridis", vmin=0.0, vmax=1.0, s=60, edgecolors="k",
+                            linewidths=0.4, zorder=3)
+        fig.colorbar(points, ax=ax, label="P(3D) over seeds")
+        for _, cell in cells[(cells["p_in_plane"] > 0) & (cells["p_in_plane"] < 1)].iterrows():
+            ax.annotate(f"{cell['p_in_plane']:.2f}", (cell["theta0_deg"], cell["g0"]),
+                        textcoords="offset points", xytext=(0, 7), ha="center", fontsize=6)
+    mixed = cells[cells["determined"] < cells["seeds"]]
+    if len(mixed):
+        ax.scatter(mixed["theta0_deg"], mixed["g0"], s=230 if style == "pie" else 150,
+                   facecolors="none", edgecolors="#d62728", linewidths=0.9, zorder=4,
+                   label="some seeds not determined")
+    theta = np.linspace(1.0, 90.0, 300)
+    for sector, line in (("in-plane", "--"), ("out-of-plane", ":")):
+        q_sector = circle.critical_q(16, sector)
+        ax.plot(theta, 3 * q_sector / np.sin(np.radians(theta)), "k", ls=line, lw=1.0,
+                label=f"{sector} threshold, q = {q_sector:.3f}")
+    ax.set_xlim(0, 92)
+    ax.set_ylim(0, 1.08 * cells["g0"].max())
+    ax.set_xlabel(r"initial tilt $\theta_0$ (deg)")
+    ax.set_ylabel(r"$g_0$ (gravity / stiffness)")
+    seeds = sorted(set(int(k) for k in cells["seeds"]))
+    count = str(seeds[0]) if len(seeds) == 1 else f"{seeds[0]}-{seeds[-1]}"
+    ax.set_title(f"regime probabilities per cell over {count} seeds" if style == "pie" else
+                 f"P(3D) per cell over {count} seeds (numbers: P(in-plane))", fontsize=10)
+    ax.legend(fontsize=7, frameon=False, loc="upper center", bbox_to_anchor=(0.5, -0.14),
+              ncol=3)
+    return fig
+
+
+def tilt_distribution(cells, frame=None, ax=None):
+    """Terminal tilt against q0 as distributions (the distributional form of the paper's
+    Fig. 7): per cell the median with its 95 % bootstrap interval (bars) and quartiles
+    (thin bars), every seed's tilt faint behind (``frame``, the rows), with the
+    out-of-plane threshold."""
+    fig, ax = single_axes(ax, (6.0, 4.0))
+    q0 = cells["g0"] * np.sin(np.radians(cells["theta0_deg"])) / 3
+    if frame is not None:
+        ax.scatter(frame["q0"], frame["theta_final_deg"], s=6, color="0.75", zorder=1,
+                   label="each seed")
+    shift = 0.012 * (q0.max() - q0.min() if len(q0) > 1 else 1.0)  # beside the medians
+    ax.errorbar(q0 + shift, cells["tilt_median"],
+                yerr=[cells["tilt_median"] - cells["tilt_q25"],
+                      cells["tilt_q75"] - cells["tilt_median"]],
+                fmt="none", ecolor="0.45", elinewidth=0.8, capsize=3, zorder=2,
+                label="quartiles")
+    ax.errorbar(q0, cells["tilt_median"],
+                yerr=[cells["tilt_median"] - cells["tilt_median_low"],
+                      cells["tilt_median_high"] - cells["tilt_median"]],
+                fmt="o", ms=3.5, color="#3b0f70", elinewidth=1.6, zorder=3,
+                label="median, 95% interval")
+    q_out = circle.critical_q(16, "out-of-plane")
+    ax.axvline(q_out, color="k", ls=":", lw=1.0, label=f"out-of-plane threshold, q = {q_out:.3f}")
+    ax.set_xlabel(r"$q_0 = g_0 \sin\theta_0 / 3$")
+    ax.set_ylabel(r"terminal tilt $\theta$ (deg)")
+    ax.set_title("terminal tilt over seeds", fontsize=10)
+    ax.legend(fontsize=7, framealpha=0.9, loc="best")
+    return fig
+
+
+def aspect_distribution(cells, frame=None, branch=None, ax=None):
+    """Terminal aspect ratio against terminal q as distributions (the distributional form
+    of the paper's Fig. 8): per cell the median aspect ratio with its 95 % bootstrap
+    interval (bars) and quartiles (thin bars) at the median terminal q with its quartiles
+    (horizontal bars), every seed faint behind (``frame``), over the steady branch
+    (``branch``: a DataFrame as ``stability.branch.steady_branch`` returns, or None)."""
+    fig, ax = single_axes(ax, (6.0, 4.0))
+    ax.axhline(1.0, color="0.85", lw=0.8, zorder=0)
+    if frame is not None:
+        ax.scatter(frame["q_final"], frame["aspect_ratio"], s=6, color="0.75", zorder=1,
+                   label="each seed")
+    if branch is not None and len(branch):
+        branch_lines(ax, branch)
+    q, ratio = cells["q_final_median"], cells["aspect_median"]
+    ax.errorbar(q, ratio, xerr=[q - cells["q_final_q25"], cells["q_final_q75"] - q],
+                yerr=[ratio - cells["aspect_q25"], cells["aspect_q75"] - ratio],
+                fmt="none", ecolor="0.45", elinewidth=0.8, capsize=2, zorder=3,
+                label="quartiles")
+    ax.errorbar(q, ratio, yerr=[ratio - cells["aspect_median_low"],
+                                cells["aspect_median_high"] - ratio],
+                fmt="o", ms=3.5, color="#3b0f70", elinewidth=1.6, zorder=4,
+                label="median, 95% interval")
+    ax.set_xlabel(r"terminal $q = g_0 \sin\theta / 3$")
+    ax.set_ylabel("terminal aspect ratio")
+    ax.set_title("terminal shape over seeds", fontsize=10)
+    ax.set_xlim(left=0)
+    ax.legend(fontsize=7, framealpha=0.9, loc="best")
+    return fig
+
+
+def distribution_summary(cells, frame, branch=None):
+    """The panels of a summary table (``summary.summarize``) and its rows: the regime
+    probabilities per cell (:func:`probability_phase_diagram`), the terminal tilt over the seeds
+    (:func:`tilt_distribution`) and, when the table has terminal q, the aspect ratio
+    over the steady branch ``branch`` (:func:`aspect_distribution`)."""
+    panels = 3 if "q_final_median" in cells else 2
+    fig, axes = plt.subplots(1, panels, figsize=(6.6 * panels, 4.4), constrained_layout=True)
+    probability_phase_diagram(cells, ax=axes[0])
+    tilt_distribution(cells, frame, ax=axes[1])
+    if panels == 3:
+        aspect_distribution(cells, frame, branch=branch, ax=axes[2])
+    return fig
