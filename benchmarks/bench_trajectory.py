@@ -118,7 +118,10 @@ def draw(rows, path, baseline):
     keys = sorted({(r["g0"], r["theta0"], r["n"]) for r in rows})
     cases = sorted({k[:2] for k in keys})
     orders = sorted({k[2] for k in keys})
-    fig, axes = plt.subplots(len(cases), len(orders), figsize=(3.3 * len(orders), 2.9 * len(cases)),
+    from matplotlib.ticker import NullFormatter
+
+    fig, axes = plt.subplots(len(cases), len(orders),
+                             figsize=(max(3.4 * len(orders), 6.4), 2.9 * len(cases) + 0.6),
                              squeeze=False, sharey=True, constrained_layout=True)
     styles = {"radau5": ("C0", "o"), "radau5-old": ("C7", "s"), "lsoda": ("C1", "^"),
               "bdf": ("C2", "v")}
@@ -140,12 +143,13 @@ def draw(rows, path, baseline):
         ax.set_title(f"g0 = {g0:g}, θ0 = {theta0:g}°, n = {n}", fontsize=9)
         ax.grid(True, which="major", lw=0.4, alpha=0.5)
         ax.tick_params(labelsize=8)
+        ax.xaxis.set_minor_formatter(NullFormatter())
     for ax in axes[-1]:
         ax.set_xlabel("wall time (s, one core)", fontsize=9)
     for ax in axes[:, 0]:
         ax.set_ylabel("terminal-tilt error (deg)", fontsize=9)
     handles, labels = axes[0, 0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="outside lower center", ncol=3, fontsize=7.5, frameon=False)
+    fig.legend(handles, labels, loc="outside lower center", ncol=2, fontsize=7.5, frameon=False)
     fig.savefig(path, dpi=110)
     plt.close(fig)
 

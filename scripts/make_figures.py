@@ -59,7 +59,8 @@ The steps (the runs), with the figures that need them:
 
 The figure suite's own runs (all but ``main_job`` and ``seed_cells``) skip the twin
 (``--no-twin``): these figures draw no determinacy, and the twin would cost 1.5-2.5x.
-Fig. 3 and nonlocal_thresholds (the circle's critical q against ε) need no run.  Nothing
+work_precision (docs/performance.md) runs ``benchmarks/bench_trajectory.py`` itself
+(``WORK_PRECISION``: about 15 minutes on one core).  Fig. 3 and nonlocal_thresholds (the circle's critical q against ε) need no run.  Nothing
 here is random beyond the seeded initial perturbations
 (seed 0 unless stated), so a rerun reproduces the tables.
 
@@ -101,6 +102,15 @@ FIGURE_DPI = {"fig6_evolution": 80}
 #: each at ``--n auto`` with 121 snapshots, drawn by ``loopsim animate`` (60 frames).
 MOVIES = (("movie_stable", "10", "30", "6"), ("movie_in_plane", "60", "30", "6"),
           ("movie_3d", "150", "60", "3"))
+#: docs/performance.md's work-precision figure: ``benchmarks/bench_trajectory.py`` (terminal
+#: tilt at t = 2 against a same-start radau5 rtol 1e-11 run; radau5 now and at the
+#: benchmark's baseline revision, scipy's LSODA and BDF on loopsim's compiled kernels), and
+#: its --quick stand-in (one case at n = 8, t = 0.1, two tolerances, no baseline).
+WORK_PRECISION = ["--cases", "150:45,100:60", "--orders", "16,24",
+                  "--methods", "radau5,radau5-old,lsoda,bdf"]
+QUICK_WORK_PRECISION = ["--cases", "100:60", "--orders", "8", "--methods", "radau5,lsoda,bdf",
+                        "--rtols", "1e-3,1e-5", "--repeats", "1", "--t-end", "0.1",
+                        "--reference-rtol", "1e-9"]
 
 
 def resolved_cases(path, quick=False):
@@ -237,6 +247,7 @@ def targets(quick=False):
         "seeds_auto_grid": (["seeds_auto_grid"], ("summary", "seeds_auto_grid")),
         **{f"anim_{step[len('movie_'):]}": ([step], ("animate", step)) for step, *_ in MOVIES},
         "report_main_job": (["main_job"], ("report", "main_job")),
+        "work_precision": ([], ("benchmark",)),
         "seed_distributions": (["seeds_n6", "seeds_auto"],
                                ("figures", "seeds_n6", ["seeds_n6", "seeds_auto"], "seeds",
                                 "seed_distributions")),
@@ -310,6 +321,15 @@ def draw(name, how, paths, out, work, quick):
         loopsim(["animate", paths[how[1]], "--out", target], dry_run=False)
     elif kind == "report":
         loopsim(["report", paths[how[1]], "--out", target], dry_run=False)
+    elif kind == "benchmark":
+        command = [sys.executable, os.path.join(os.path.dirname(__file__), os.pardir,
+                                                "benchmarks", "bench_trajectory.py"),
+                   *(QUICK_WORK_PRECISION if quick else WORK_PRECISION),
+                   "--out", os.path.join(work, f"{name}.json"), "--figure", target]
+        print("$ " + " ".join(shlex.quote(a) for a in command), flush=True)
+        os.makedirs(work, exist_ok=True)
+        os.makedirs(out, exist_ok=True)
+        subprocess.run(command, check=True, env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
     elif kind == "stability":
         n = 6 if quick else 16
         fig = figures.stability(*figures.stability_data(n=n, n_values=range(3, n + 1)))
