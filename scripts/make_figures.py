@@ -107,7 +107,7 @@ MOVIES = (("movie_stable", "10", "30", "6"), ("movie_in_plane", "60", "30", "6")
 #: benchmark's baseline revision, scipy's LSODA and BDF on loopsim's compiled kernels), and
 #: its --quick stand-in (one case at n = 8, t = 0.1, two tolerances, no baseline).
 WORK_PRECISION = ["--cases", "150:45,100:60", "--orders", "16,24",
-                  "--methods", "radau5,radau5-old,lsoda,bdf"]
+                  "--methods", "radau5,radau5-old,lsoda,bdf", "--repeats", "2"]
 QUICK_WORK_PRECISION = ["--cases", "100:60", "--orders", "8", "--methods", "radau5,lsoda,bdf",
                         "--rtols", "1e-3,1e-5", "--repeats", "1", "--t-end", "0.1",
                         "--reference-rtol", "1e-9"]
