@@ -106,7 +106,7 @@ def test_old_layout_is_refused_in_one_line(tmp_path, capsys):
     out.mkdir()
     (out / "sweep.json").write_text("{}")
     (out / "chunk-00000.parquet").write_bytes(b"PAR1")
-    with pytest.raises(ValueError, match="loopsim <= 0.2.0.*new --out"):
+    with pytest.raises(ValueError, match=r"layout-1 .*loopsim 0\.2\.0 and earlier releases.*new --out"):
         loopsim.read_results(str(out))
     assert main(["sweep", "--g0", "10", "--theta0", "30", "--out", str(out)]) == 2
     err = capsys.readouterr().err
