@@ -2,9 +2,12 @@
 
 Conventions used throughout loopsim (stated once, tested in ``tests/``):
 
-* Lengths are scaled by L / 2π, so the loop has length 2π and arc length
-  s ∈ [0, 2π).  Forces are scaled by 8π³EI / L³ (per unit length, per L³),
-  time so that the dimensionless equations read (paper §3)::
+* Lengths are scaled by ℓ = L / 2π, so the loop has length 2π and arc length
+  s ∈ [0, 2π).  Force densities are scaled by EI/ℓ³ = 8π³EI / L³, forces (the
+  multiplier T, the axial force N) by EI/ℓ² = EI (2π/L)², and time by
+  t_u = ζ⊥ ℓ⁴ / EI (ζ⊥ = 8πμ/c, c = −2 ln(a/L): the perpendicular drag coefficient per
+  unit length), so that the dimensionless equations read (paper §3; docs/model.md,
+  "Units")::
 
       f = -x'''' + (T x')' - g0 e_z
       u = f + (x'·f) x'

@@ -1,11 +1,14 @@
 """Outcomes as distributions (loopsim.summary): the Wilson interval and the bootstrap
 against closed forms and known cases, cells and their counts, the command."""
+import json
+
 import numpy as np
 import pandas as pd
+import pyarrow.parquet as pq
 import pytest
 
 import loopsim
-from loopsim import summary
+from loopsim import columns, summary
 from loopsim.cli import main
 
 
@@ -74,6 +77,10 @@ def test_summary_command_on_a_sweep_with_seeds(tmp_path, capsys):
     assert list(table["g0"]) == [10.0, 40.0] and list(table["seeds"]) == [3, 3]
     again = loopsim.summarize(loopsim.read_results(str(out)))
     pd.testing.assert_frame_equal(table, again)
+    schema = pq.read_schema(path)
+    for field in schema:  # every column declared in loopsim.columns, with its unit
+        assert field.metadata[b"unit"] == columns.SUMMARY_COLUMNS[field.name][0].encode()
+    assert schema.metadata[b"summary_of"] == b"s"  # the directory's name, not its path
 
 
 def _seeds_table(tilts, regimes=None, g0=150.0):
@@ -115,6 +122,10 @@ def test_compare_command_on_two_sweeps(tmp_path, capsys):
     printed = capsys.readouterr().out
     assert "2 cell(s) indistinguishable at this sample size" in printed
     assert len(pd.read_parquet(tmp_path / "c.parquet")) == 2
+    schema = pq.read_schema(tmp_path / "c.parquet")
+    assert {f.name: f.metadata[b"description"].decode() for f in schema} == {
+        name: columns.COMPARE_COLUMNS[name][1] for name in schema.names}
+    assert json.loads(schema.metadata[b"compared"]) == ["a", "b"]
     assert main(["compare", str(tmp_path / "a"), str(tmp_path / "b"), "--alpha", "0"]) == 2
 
 

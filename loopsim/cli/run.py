@@ -31,8 +31,9 @@ def add_parser(commands):
         formatter_class=HelpFormatter,
     )
     run.add_argument("--g0", type=real,
-                     help="gravity over bending stiffness, g0 = L^3 g rho_L / (8 pi^3 EI) >= 0 "
-                     "(required, except when continuing from results: then their g0)")
+                     help="gravity over bending stiffness, g0 = L^3 g rho_L / (8 pi^3 EI) >= 0, "
+                     "dimensionless (required, except when continuing from results: then their "
+                     "g0)")
     run.add_argument("--theta0", type=real, metavar="DEG",
                      help="initial tilt of the loop's plane to the horizontal, in [0, 90] degrees "
                      "(not with --initial: the tilt is measured)")
@@ -47,7 +48,8 @@ def add_parser(commands):
                      help="with --initial results: the case whose terminal shape starts the run")
     add_integration_options(run)
     run.set_defaults(perturbation=None)
-    run.add_argument("--seed", type=int, default=DEFAULT_SEED, help="perturbation seed (>= 0)")
+    run.add_argument("--seed", type=int, default=DEFAULT_SEED, metavar="SEED",
+                     help="perturbation seed (>= 0)")
     run.add_argument("--snapshots", type=int, default=2, metavar="K",
                      help="states stored of the trajectory: K equally spaced times, both "
                      "ends included (as sweep --snapshots; here the start and the end by "

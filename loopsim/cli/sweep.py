@@ -45,8 +45,10 @@ def add_parser(commands):
         formatter_class=HelpFormatter,
     )
     grid = sweep.add_argument_group("cases (a grid, or --cases FILE)")
-    grid.add_argument("--g0", metavar="START:STOP:NUM|v1,v2,...", help="g0 values")
-    grid.add_argument("--theta0", metavar="START:STOP:NUM|v1,v2,...", help="theta0 values (deg)")
+    grid.add_argument("--g0", metavar="START:STOP:NUM|v1,v2,...",
+                      help="g0 values (gravity over bending stiffness, dimensionless)")
+    grid.add_argument("--theta0", metavar="START:STOP:NUM|v1,v2,...",
+                      help="initial tilts, in degrees")
     grid.add_argument("--n", default=str(DEFAULT_N), metavar="N[,N...]|auto",
                       help="truncation orders, or auto: every case starts at n = "
                       f"{DEFAULT_N} and climbs (up to --n-max) whenever its spectral tail passes "
@@ -75,8 +77,9 @@ def add_parser(commands):
     sweep.add_argument("--snapshots", type=int, default=101, metavar="K",
                        help="states stored of each --snapshots-for trajectory: K equally "
                        "spaced times, both ends included (as run --snapshots)")
-    sweep.add_argument("--threads", type=int, default=None, help="threads (default: all cores)")
-    sweep.add_argument("--chunk-size", type=int, default=None,
+    sweep.add_argument("--threads", type=int, default=None, metavar="K",
+                       help="threads (default: all cores)")
+    sweep.add_argument("--chunk-size", type=int, default=None, metavar="K",
                        help="cases per chunk file (and per Dask task; default "
                        f"{DEFAULT_CHUNK_SIZE}, or {DEFAULT_AUTO_CHUNK_SIZE} with --n auto, "
                        "whose cases take minutes: a SIGKILL loses the unwritten chunks); may "
@@ -87,14 +90,15 @@ def add_parser(commands):
     sweep.add_argument("--figure", metavar="PNG", help="also draw the phase diagram")
     sweep.add_argument("--quiet", action="store_true", help="no progress line, only a summary")
     sweep.add_argument("--progress-every", type=real, default=30.0, metavar="SECONDS",
-                       help="progress line interval when stderr is not a terminal (a log file)")
+                       help="progress line interval, in seconds of wall time, when stderr is "
+                       "not a terminal (a log file)")
     where = sweep.add_argument_group("where the cases run (default: this machine's threads)")
     where.add_argument("--scheduler", metavar="ADDRESS",
                        help="send chunks as tasks to the Dask scheduler at ADDRESS "
                        "(tcp://host:8786); finished chunks come back and are written here")
     where.add_argument("--dask", action="store_true",
                        help="start a Dask LocalCluster here and send chunks to it")
-    where.add_argument("--workers", type=int, default=None,
+    where.add_argument("--workers", type=int, default=None, metavar="K",
                        help="with --dask: worker processes, at most the cores (default: "
                        "cores / --threads)")
     where.add_argument("--shard", metavar="I/N",
