@@ -150,8 +150,36 @@ def quarantine(directory, path, reason):
 
 
 def read_snapshots(out):
-    """Trajectory snapshots of the cases chosen with ``snapshots_for`` (a DataFrame): the
-    snapshot files whose result file is there (one cut short has none)."""
+    """The stored trajectories of a sweep: one row per snapshot of each case chosen with
+    ``snapshots_for`` (``--snapshots-for``).
+
+    Only the snapshot files whose result file is there are read (a piece cut short has
+    none), each checked (page checksums, content hash).
+
+    Parameters
+    ----------
+    out : str
+        A sweep directory.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The columns of ``loopsim.columns.TRAJECTORY_COLUMNS`` (``case_id``, ``t`` in t_u,
+        ``theta_deg``, ``x`` in L/2π ...), sorted by (case_id, t); empty when no
+        snapshot was stored or ``out`` does not exist.
+
+    Raises
+    ------
+    ValueError
+        A damaged snapshot file (named; the sweep's command recomputes it), or a
+        layout-1 directory.
+
+    Examples
+    --------
+    >>> import loopsim
+    >>> loopsim.sweep(150, 60, "runs/one", n=6, snapshots_for=[0])  # doctest: +SKIP
+    >>> loopsim.read_snapshots("runs/one").groupby("case_id")["t"].max()  # doctest: +SKIP
+    """
     if not os.path.isdir(out):
         return pd.DataFrame()
     check_layout(out)
