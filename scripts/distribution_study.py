@@ -63,7 +63,7 @@ def same_start_run(g0, theta0_deg, seed, n):
     with the sweep's defaults and early stop, no twin: its summary row."""
     start = shapes.initial_shape(refinement.AUTO_START, math.radians(theta0_deg),
                                  config.DEFAULT_PERTURBATION, seed)
-    result = loopsim.simulate(g0, None, initial=spectral.resize(start, n), method="auto",
+    result = loopsim.simulate(g0, None, initial=spectral.resize(start, n), n=n, method="auto",
                               twin=False, steady_tol=config.DEFAULT_STEADY_TOL,
                               steady_interval=config.DEFAULT_STEADY_INTERVAL)
     # the cell's inputs as given (the measured tilt differs from them by the perturbation)

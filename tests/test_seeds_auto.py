@@ -145,7 +145,7 @@ def test_seeds_auto_from_the_command_line(tmp_path, capsys):
                          (["--seeds", "many"], "--seeds must be a count"),
                          (["--seeds", "auto", "--shard", "0/2"], "--shard does not apply"),
                          (["--seeds", "auto", "--max-seeds", "2"], "--min-seeds and --max")):
-        base = ["sweep", "--g0", "10", "--theta0", "30", "--out", str(tmp_path / "bad")]
+        base = ["sweep", "--n", "6", "--g0", "10", "--theta0", "30", "--out", str(tmp_path / "bad")]
         assert main(base + bad) == 2
         assert message in capsys.readouterr().err
     assert not (tmp_path / "bad").exists()

@@ -66,7 +66,7 @@ def test_summarize_groups_seeds_into_cells():
 
 def test_summary_command_on_a_sweep_with_seeds(tmp_path, capsys):
     out = tmp_path / "s"
-    assert main(["sweep", "--g0", "10,40", "--theta0", "30", "--seeds", "3", "--t-end", "0.5",
+    assert main(["sweep", "--n", "6", "--g0", "10,40", "--theta0", "30", "--seeds", "3", "--t-end", "0.5",
                  "--no-twin", "--quiet", "--out", str(out)]) == 0
     capsys.readouterr()
     path = tmp_path / "cells" / "summary.parquet"
@@ -113,7 +113,7 @@ def test_compare_verdicts_on_one_distribution_and_on_shifted_ones():
 def test_compare_command_on_two_sweeps(tmp_path, capsys):
     """rtol 1e-6 against 1e-7 on stable cells: the same distributions."""
     for name, rtol in (("a", "1e-6"), ("b", "1e-7")):
-        assert main(["sweep", "--g0", "10,40", "--theta0", "30", "--seeds", "4", "--t-end",
+        assert main(["sweep", "--n", "6", "--g0", "10,40", "--theta0", "30", "--seeds", "4", "--t-end",
                      "0.5", "--rtol", rtol, "--no-twin", "--quiet", "--out",
                      str(tmp_path / name)]) == 0
     capsys.readouterr()
@@ -235,7 +235,7 @@ def test_summary_figure_of_cells_sharing_a_point_is_refused_before_writing(tmp_p
     cases = tmp_path / "cases.csv"
     cases.write_text("g0,theta0_deg,n,seed,rtol\n10,30,4,0,1e-6\n10,30,4,0,1e-7\n")
     out = tmp_path / "s"
-    assert main(["sweep", "--cases", str(cases), "--t-end", "0.2", "--no-twin", "--quiet",
+    assert main(["sweep", "--n", "6", "--cases", str(cases), "--t-end", "0.2", "--no-twin", "--quiet",
                  "--threads", "1", "--out", str(out)]) == 0
     capsys.readouterr()
     table, figure = tmp_path / "cells.parquet", tmp_path / "cells.png"

@@ -69,7 +69,7 @@ class SweepConfig:
     steady_interval: float = DEFAULT_STEADY_INTERVAL
     steady_tol: float = DEFAULT_STEADY_TOL
     thresholds: Thresholds = Thresholds()
-    n_auto: bool = False  # raise n during each run (loopsim.refinement)
+    n_auto: bool = False  # restart a case from t0 at the next order past tail_tol (refinement)
     n_max: int = DEFAULT_N_MAX
     tail_tol: float = DEFAULT_TAIL_TOL
     twin: bool = True  # run each case's stricter twin (loopsim.outcomes: determined or not)
