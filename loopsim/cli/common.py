@@ -19,6 +19,21 @@ METHODS = ("radau5", "rkf45")
 EXIT_FAILED_RUN = 1
 EXIT_USAGE = 2
 EXIT_ENVIRONMENT = 3
+#: Every command's exit statuses, in one table (docs/cli.md, "Exit codes"; each --help's
+#: epilog): status, meaning.
+EXIT_CODES = (
+    (0, "success"),
+    (EXIT_FAILED_RUN, "a run, or a sweep's case, failed numerically (its summary or row "
+                      "says why)"),
+    (EXIT_USAGE, "bad input: one line 'loopsim: error: ...' on stderr, nothing written"),
+    (EXIT_ENVIRONMENT, "the machine's fault: disk full, read-only filesystem, I/O error, "
+                       "no memory or file handles left (re-run once fixed: sweeps resume)"),
+    (130, "stopped by SIGINT (Ctrl-C: a sweep keeps its finished cases)"),
+    (143, "stopped by SIGTERM (as 130)"),
+)
+#: The epilog of every command's --help: the exit statuses in one paragraph.
+EXIT_EPILOG = "Exit status: " + "; ".join(f"{code} {text}" for code, text in EXIT_CODES) + \
+    " (docs/cli.md)."
 #: Where the units of every option are defined.
 UNITS = "docs/model.md#units"
 

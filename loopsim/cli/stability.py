@@ -29,8 +29,8 @@ def add_parser(commands):
     full.add_argument("--q-scan", metavar="START:STOP:NUM|v1,v2,...",
                       help="also the largest growth rate of each sector, the paper's and the "
                       "corrected operator at these q")
-    full.add_argument("--g0", type=real, metavar="G",
-                      help="also the spectrum at g0 = G (dimensionless) and --theta0: the --top "
+    full.add_argument("--g0", type=real, metavar="G0",
+                      help="also the spectrum at g0 = G0 (dimensionless) and --theta0: the --top "
                       "largest eigenvalues (growth rates, in 1/t_u) with sector labels")
     full.add_argument("--top", type=int, default=None, metavar="K",
                       help="eigenvalues listed with --g0 (default: 12)")
