@@ -46,24 +46,24 @@ def _argument(action):
 
 
 def command_reference(name, parser):
-    """Markdown of one command: synopsis, description, one table per argument group."""
+    """Markdown of one command: synopsis, description, and a table of its arguments (each
+    argument group's title a row of its own)."""
     formatter = parser.formatter_class(prog=parser.prog, width=WIDTH)
     usage = parser.format_usage().strip()
     lines = [f"### `loopsim {name}`", "", "    " + usage.replace("\n", "\n    "), ""]
     if parser.description:
         lines += [" ".join(parser.description.split()), ""]
+    lines += ["| argument | meaning |", "|---|---|"]
     for group in parser._action_groups:
         actions = [a for a in group._group_actions if a.help is not argparse.SUPPRESS
                    and not isinstance(a, argparse._HelpAction)]
         if not actions:
             continue
-        title = group.title if group.title not in ("options", "optional arguments") else None
-        if title:
-            lines += [f"*{_cell(title)}*", ""]
-        lines += ["| argument | meaning |", "|---|---|"]
+        if group.title not in ("options", "optional arguments", "positional arguments"):
+            lines.append(f"| *{_cell(group.title)}* | |")
         lines += [f"| {_code(_argument(a))} | {_cell(formatter._expand_help(a))} |"
                   for a in actions]
-        lines.append("")
+    lines.append("")
     return lines
 
 

@@ -115,7 +115,7 @@ def test_continuation_equals_one_longer_run(tmp_path, capsys):
     x, info = shapes.load_initial(path)
     assert np.array_equal(x, first.x_final)  # exact: stored coefficients, no resampling
     assert info["kind"] == "run" and info["g0"] == 60 and info["t_final"] == 1.0
-    more = api.simulate(60, None, initial=path, t_span=(0, 0.5), **TIGHT)
+    more = api.simulate(60, None, initial=path, n=6, t_span=(0, 0.5), **TIGHT)
     whole = api.simulate(60, 30, n=6, t_span=(0, 1.5), **TIGHT)
     difference = np.max(np.abs(more.x_final - whole.x_final))
     assert difference < 1e-8, difference  # measured ~1e-11

@@ -237,7 +237,7 @@ def stop_table(cells, rows, targets, checks=None):
             verdicts[keys + list(CHECK_COLUMNS.values())], on=keys, how="left")
         table["check_seeds"] = table["check_seeds"].fillna(0).astype("int64")
         table["check_verdict"] = table["check_verdict"].fillna("")
-    table["n"] = table["n"].astype("Int64")  # an order: an integer column, even with nulls
+    table["n"] = table["n"].astype("int64")  # an order (every cell has one): never a float
     return table
 
 
