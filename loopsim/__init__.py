@@ -19,7 +19,8 @@ Main entry points:
 
 Internals, each layer importing only those above it: ``config``, ``validation``,
 ``spectral``, ``dispatch``; ``models``; ``integrators``; ``batch``; ``diagnostics``,
-``shapes``, ``stability``; ``io``; ``api``, ``sweeps``, ``summary``, ``figures``, ``cli``.
+``shapes``, ``stability``; ``io``; ``result``, ``api``, ``sweeps``, ``summary``, ``figures``,
+``cli``.
 """
 from . import _signals
 

@@ -70,10 +70,10 @@ def command_reference(name, parser):
 def generated():
     """The generated part of docs/cli.md, markers included."""
     os.environ["COLUMNS"] = str(WIDTH)  # argparse wraps the synopses to this width
-    from loopsim.cli import _build_parser
+    from loopsim.cli import build_parser
     from loopsim.cli.common import EXIT_CODES
 
-    parser = _build_parser()
+    parser = build_parser()
     commands = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
     lines = [BEGIN, "", "## Exit codes", "",
              "Every command ends with one of these statuses (also at the end of its "

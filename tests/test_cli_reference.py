@@ -44,7 +44,7 @@ def test_the_reference_covers_every_registered_command(monkeypatch):
 
     monkeypatch.setitem(cli.COMMANDS, "extra", types.SimpleNamespace(add_parser=add_parser))
     text = reference_script().generated()
-    for name in subcommands(cli._build_parser()):
+    for name in subcommands(cli.build_parser()):
         assert f"### `loopsim {name}`" in text, name
     assert "<code>--size SIZE</code> | its size, in L/2pi |" in text
     for code, _ in EXIT_CODES:
@@ -52,7 +52,7 @@ def test_the_reference_covers_every_registered_command(monkeypatch):
 
 
 def test_every_help_ends_with_the_exit_codes():
-    parser = cli._build_parser()
+    parser = cli.build_parser()
     for name, command in subcommands(parser).items():
         assert command.format_help().rstrip().endswith("(docs/cli.md)."), name
         assert all(f"{code} " in command.epilog for code, _ in EXIT_CODES), name
@@ -61,7 +61,7 @@ def test_every_help_ends_with_the_exit_codes():
 
 def test_one_metavar_means_one_quantity():
     """EPS is the slenderness only (not the perturbation's size nor the onset's)."""
-    for name, command in subcommands(cli._build_parser()).items():
+    for name, command in subcommands(cli.build_parser()).items():
         for action in command._actions:
             metavars = action.metavar if isinstance(action.metavar, tuple) else (action.metavar,)
             if "EPS" in metavars:
@@ -74,13 +74,13 @@ def test_one_metavar_means_one_quantity():
                                           ("--theta0", "degrees")])
 def test_the_physical_options_give_their_units(option, unit):
     for name in ("run", "sweep"):
-        command = subcommands(cli._build_parser())[name]
+        command = subcommands(cli.build_parser())[name]
         action = next(a for a in command._actions if option in a.option_strings)
         assert unit in action.help, (name, option)
 
 
 def test_sweep_help_lists_its_cases_before_the_tuning_options():
-    text = subcommands(cli._build_parser())["sweep"].format_help()
+    text = subcommands(cli.build_parser())["sweep"].format_help()
     body = text[text.index("options:"):]
     first = [body.index("\n  " + option) for option in (
         "--g0 START", "--n N", "--model", "--rtol", "--p-halfwidth", "--out", "--scheduler")]
@@ -90,7 +90,7 @@ def test_sweep_help_lists_its_cases_before_the_tuning_options():
 def test_the_top_level_examples_include_the_readme_main_job():
     from test_readme import main_command
 
-    epilog = cli._build_parser().epilog
+    epilog = cli.build_parser().epilog
     assert " ".join(shlex.quote(w) for w in main_command()) in epilog
     assert "--n 6 --method rkf45" in epilog  # the paper's scheme, one flag away
     assert "--out runs/phase_n6" in epilog and "--n 6 --method rkf45 --out runs/phase " not in epilog

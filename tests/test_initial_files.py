@@ -271,3 +271,21 @@ def test_n_auto_starts_a_point_file_at_the_order_its_content_needs(tmp_path, cap
     # a fixed n is what it says: the file fitted at that order
     assert api.simulate(60.0, None, initial=path, n=6, t_span=(0.0, 0.01),
                         twin=False).inputs["n"] == 6
+
+
+def test_a_cases_file_point_row_with_n_auto_starts_at_its_content_order(tmp_path, capsys):
+    """The sweep's counterpart of ``run --initial POINTS --n auto``: a cases-file row
+    that starts from a point file and gives no n starts at the order its content needs;
+    a row that gives n keeps it."""
+    x = shapes.initial_shape(6, np.radians(45.0), 1e-3, 3)
+    s = np.linspace(0.0, 2.0 * np.pi, 256, endpoint=False)
+    write_points(tmp_path / "tilted.csv", spectral.evaluate(x, s).T)
+    order = shapes.auto_start_order(str(tmp_path / "tilted.csv"))
+    cases = tmp_path / "cases.csv"
+    cases.write_text("g0,initial\n60,tilted.csv\n")
+    out = str(tmp_path / "s")
+    assert main(["sweep", "--cases", str(cases), "--n", "auto", "--t-end", "0.01", "--no-twin",
+                 "--quiet", "--out", out]) == 0
+    assert order > 6 and loopsim.read_results(out)["n"].tolist() == [order]
+    fixed = sweeps.read_cases_file(str(cases), n=8)  # no --n auto: the given order
+    assert fixed[0]["n"] == 8

@@ -22,7 +22,7 @@ from ..config import ENVIRONMENT_ERRNOS
 from . import branch, compare, figures, run, stability, summary, sweep
 from .common import EXIT_ENVIRONMENT, EXIT_EPILOG, EXIT_FAILED_RUN, EXIT_USAGE, METHODS, Parser
 
-__all__ = ["EXIT_ENVIRONMENT", "EXIT_FAILED_RUN", "EXIT_USAGE", "METHODS", "main"]
+__all__ = ["EXIT_ENVIRONMENT", "EXIT_FAILED_RUN", "EXIT_USAGE", "METHODS", "build_parser", "main"]
 
 #: The commands, in the order ``loopsim --help`` lists them.
 COMMANDS = {"run": run, "sweep": sweep, "stability": stability, "summary": summary,
@@ -41,7 +41,7 @@ EXAMPLES = (
 )
 
 
-def _build_parser():
+def build_parser():
     """The ``loopsim`` parser: every command of :data:`COMMANDS` (and any other a command
     module registers), each --help ending with the exit statuses (``common.EXIT_EPILOG``)."""
     parser = Parser(
@@ -74,7 +74,7 @@ def _one_line_warnings():
 
 
 def main(argv=None):
-    parser = _build_parser()
+    parser = build_parser()
     args = parser.parse_args(argv)
     try:
         with _one_line_warnings():

@@ -151,7 +151,12 @@ def _sweep_config(args, sweeps):
             raise ValueError("give either --cases or --g0/--theta0, not both")
         orders = [DEFAULT_N] if args.n == "auto" else sweeps.parse_values(args.n, "--n",
                                                                            integer=True)
-        cases = sweeps.read_cases_file(args.cases, args.perturbation, orders[0])
+        top = None
+        if args.n == "auto":  # point files start at the order their content needs
+            from .. import api, models
+
+            top = api.ladder_top(models.choose(args.model, args.slenderness), args.n_max)
+        cases = sweeps.read_cases_file(args.cases, args.perturbation, orders[0], top)
     else:
         if not (args.g0 and args.theta0):
             raise ValueError("a sweep needs --g0 and --theta0 (or --cases FILE)")

@@ -162,8 +162,34 @@ def read_results(out):
 
 
 def read_stop_table(out):
-    """The stop table of a finished ``--seeds auto`` directory: one row per cell (its
-    inputs, ``seeds``, ``rounds``, ``stop_reason``, ``p_halfwidth``, ``tilt_halfwidth_deg``)."""
+    """The stop table of a finished ``--seeds auto`` directory: why each cell stopped.
+
+    Parameters
+    ----------
+    out : str
+        A ``--seeds auto`` directory whose sweep has finished.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per cell, with the columns of ``loopsim.columns.STOP_COLUMNS`` (its
+        inputs, ``seeds``, ``rounds``, ``stop_reason``, ``p_halfwidth``,
+        ``tilt_halfwidth_deg`` in degrees, ``runs``, ``twins`` and the distribution check of
+        sampled cells); each column's unit and description are in the file's field
+        metadata.
+
+    Raises
+    ------
+    ValueError
+        The sweep has not finished (no stop table yet).
+    loopsim.io.DamagedFile
+        The stop table fails its checksums or content hash.
+
+    Examples
+    --------
+    >>> from loopsim import io
+    >>> io.read_stop_table("runs/seeds")[["g0", "theta0_deg", "seeds", "stop_reason"]]  # doctest: +SKIP
+    """
     path = os.path.join(out, STOPS_FILE)
     if not os.path.isfile(path):
         raise ValueError(f"{out!r} has no {STOPS_FILE}: its --seeds auto sweep has not "
