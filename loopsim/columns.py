@@ -4,10 +4,11 @@ The units are those of the dimensionless equations (``loopsim.config``; docs/mod
 "Units"): lengths in L/2π (the loop has length 2π), time in
 t_u = ζ⊥ (L/2π)⁴ / EI (ζ⊥ = 8πμ/c the perpendicular drag coefficient per unit length),
 forces (the axial force N, the multiplier T) in EI (2π/L)², force densities in
-EI (2π/L)³ = 8π³EI/L³, angles in degrees at the interface.  The declarations go into each Parquet
-field's metadata (keys ``unit`` and ``description``), into ``_sweep.json`` and a
-results frame's ``attrs["loopsim"]["columns"]``, and into the docs' column table
-(``python -m loopsim.columns`` prints it as Markdown).
+EI (2π/L)³ = 8π³EI/L³, angles in degrees at the interface.  The declarations go into
+each Parquet field's metadata (keys ``unit`` and ``description``), into ``_sweep.json``
+and a results frame's ``attrs["loopsim"]["columns"]``, and into the docs' column table
+(``python -m loopsim.columns [results|trajectory|summary|compare|stops]`` prints one
+as Markdown).
 """
 LENGTH = "L/2pi"
 TIME = "t_u"

@@ -16,9 +16,11 @@ def add_parser(commands):
     compare.add_argument("sweep_a", metavar="SWEEP_A", help="a sweep directory")
     compare.add_argument("sweep_b", metavar="SWEEP_B", help="another, of the same cells")
     compare.add_argument("--alpha", type=real, default=0.05, metavar="P",
-                         help="significance level (a probability) of the verdict (Bonferroni over 3 tests)")
+                         help="significance level (a probability) of the verdict (Bonferroni "
+                         "over 3 tests)")
     compare.add_argument("--out", metavar="FILE.parquet", help="also write the table to Parquet")
-    compare.add_argument("--seed", type=int, default=0, metavar="SEED", help="seed of the bootstrap (>= 0)")
+    compare.add_argument("--seed", type=int, default=0, metavar="SEED",
+                         help="seed of the bootstrap (>= 0)")
     return compare
 
 

@@ -19,7 +19,8 @@ def add_parser(commands):
     )
     summary.add_argument("sweep_dir", metavar="SWEEP_DIR", help="a sweep directory")
     summary.add_argument("--out", metavar="FILE.parquet", help="also write the table to Parquet")
-    summary.add_argument("--seed", type=int, default=0, metavar="SEED", help="seed of the bootstrap (>= 0)")
+    summary.add_argument("--seed", type=int, default=0, metavar="SEED",
+                         help="seed of the bootstrap (>= 0)")
     summary.add_argument("--figure", metavar="PNG",
                          help="also draw P(3D) per cell, the terminal tilt over seeds and the "
                          "aspect ratio over the steady branch")

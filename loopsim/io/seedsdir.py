@@ -188,7 +188,8 @@ def read_stop_table(out):
     Examples
     --------
     >>> from loopsim import io
-    >>> io.read_stop_table("runs/seeds")[["g0", "theta0_deg", "seeds", "stop_reason"]]  # doctest: +SKIP
+    >>> stops = io.read_stop_table("runs/seeds")  # doctest: +SKIP
+    >>> stops[["g0", "theta0_deg", "seeds", "stop_reason"]]  # doctest: +SKIP
     """
     path = os.path.join(out, STOPS_FILE)
     if not os.path.isfile(path):
