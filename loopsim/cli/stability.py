@@ -27,8 +27,8 @@ def add_parser(commands):
     full.add_argument("--w", type=real, default=None, metavar="W",
                       help=f"length-penalty rate, in 1/t_u (default: {DEFAULT_W:g})")
     full.add_argument("--q-scan", metavar="START:STOP:NUM|v1,v2,...",
-                      help="also the largest growth rate of each sector, the paper's and the "
-                      "corrected operator at these q")
+                      help="also the largest growth rate (in 1/t_u) of each sector, the "
+                      "paper's and the corrected operator at these q (dimensionless)")
     full.add_argument("--g0", type=real, metavar="G0",
                       help="also the spectrum at g0 = G0 (dimensionless) and --theta0: the --top "
                       "largest eigenvalues (growth rates, in 1/t_u) with sector labels")
