@@ -160,10 +160,11 @@ def _is_program():
     return is_program()
 
 
-def print_and_write(table, out, meta, declarations, shown=None):
+def print_and_write(table, out, meta, shown=None, *, declarations):
     """Print ``table`` (its ``shown`` columns) and write it to ``out`` (Parquet, atomic,
     with loopsim's provenance and ``meta`` in its metadata, and each column's unit and
-    description from ``declarations``, a table of ``loopsim.columns``) when given."""
+    description from ``declarations``, a table of ``loopsim.columns``: a column it does
+    not declare is a KeyError, before anything is written) when given."""
     import pandas as pd
     import pyarrow as pa
 

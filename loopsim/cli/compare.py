@@ -34,7 +34,8 @@ def command(args):
     table = summary.compare(io.read_results(args.sweep_a), io.read_results(args.sweep_b),
                             alpha=args.alpha, seed=args.seed)
     print_and_write(table, args.out, dict(table.attrs["loopsim_compare"], compared=[
-        directory_name(args.sweep_a), directory_name(args.sweep_b)]), columns.COMPARE_COLUMNS)
+        directory_name(args.sweep_a), directory_name(args.sweep_b)]),
+                    declarations=columns.COMPARE_COLUMNS)
     counts = table["verdict"].value_counts().to_dict()
     print(", ".join(f"{v} cell(s) {k}" for k, v in sorted(counts.items())))
     return 0

@@ -46,7 +46,7 @@ def command(args):
         "tilt_median", "tilt_median_low", "tilt_median_high"]
     print_and_write(table, args.out, dict(table.attrs["loopsim_summary"],
                                            summary_of=directory_name(args.sweep_dir)),
-                    columns.SUMMARY_COLUMNS, shown)
+                    shown, declarations=columns.SUMMARY_COLUMNS)
     if args.figure is not None:
         save_distribution_figure(table, frame, args.figure)
         print(f"figure: {args.figure}")
