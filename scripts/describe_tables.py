@@ -9,9 +9,11 @@ only (``summary_of``: never a machine's path).  The values are not recomputed: t
 reads each column back after writing and stops with an error unless it is bit-identical
 to the column before (an integer order compared with the float it replaces, which must be
 integral).  The schema metadata is kept (provenance: the version that computed the table,
-its ``created_utc``), with ``columns_described_by`` added; the content hash is
-recomputed.  Running it again changes nothing (idempotent; ``--check`` exits 1 if a file
-would change, 0 otherwise, writing nothing).
+its ``created_utc``), with ``columns_described_by`` added where the script changed the
+file; the content hash is recomputed.  A file already described (by this script, or
+written by a loopsim that declares its columns) is left as it is: running it again
+changes nothing (``--check`` exits 1 if a file would change, 0 otherwise, writing
+nothing).
 """
 import argparse
 import os
@@ -51,8 +53,15 @@ def described_table(table, declarations):
             if k.decode() != io.CONTENT_KEY}
     if "summary_of" in meta:
         meta["summary_of"] = os.path.basename(os.path.normpath(meta["summary_of"]))
-    meta["columns_described_by"] = f"scripts/describe_tables.py (loopsim {loopsim.__version__})"
     return io.described(table.replace_schema_metadata(meta), declarations)
+
+
+def with_note(table):
+    """``table`` with ``columns_described_by`` in its metadata: this script changed it."""
+    meta = dict(table.schema.metadata)
+    meta[b"columns_described_by"] = \
+        f"scripts/describe_tables.py (loopsim {loopsim.__version__})".encode()
+    return table.replace_schema_metadata(meta)
 
 
 def same_values(before, after):
@@ -95,8 +104,9 @@ def main(argv=None):
         old_meta = {k: v for k, v in before.schema.metadata.items()
                     if k.decode() != io.CONTENT_KEY}
         if table.schema.equals(before.schema.with_metadata(old_meta), check_metadata=True):
-            print(f"{name}: unchanged")
+            print(f"{name}: unchanged")  # described already (by this script, or its writer)
             continue
+        table = with_note(table)
         stale.append(name)
         if args.check:
             print(f"{name}: would change")
