@@ -1,17 +1,26 @@
 """loopsim: flexible elastic loops sedimenting in a viscous (Stokes) fluid.
 
-Layout (each layer imports only those above it):
+A closed inextensible elastic filament (Euler-Bernoulli bending, local or nonlocal
+slender-body theory) falling under gravity, after Waszkiewicz, Szymczak & Lisicki,
+J. Fluid Mech. 919, A14 (2021): its centreline is a Fourier series of order n, time-stepped
+by RKF45 (the paper's scheme) or Radau IIA, and every run says whether its order resolves
+it and whether its terminal state is determined.  Units: docs/model.md, "Units".
 
-* ``config``, ``validation``, ``spectral``, ``dispatch``: conventions, input
-  checks, Fourier algebra, generic functions for jitted code;
-* ``models``: equations of motion behind one interface (``local_sbt``: the loop);
-* ``integrators``: one adaptive driver, methods as data (RKF45, Radau IIA);
-* ``batch``: many cases in one parallel kernel;
-* ``diagnostics``, ``shapes``, ``stability``: shape measures, initial shapes,
-  linear stability of the circle;
-* ``io``: table schemas, Parquet writing and reading;
-* ``api`` (``simulate``), ``sweeps`` (``loopsim.ensemble``: its earlier name), ``plots``,
-  ``cli``.
+Main entry points:
+
+* :func:`simulate`: one loop, to a resolved terminal state by default (``n="auto"``;
+  the paper's scheme is ``n=6, method="rkf45"``); returns a :class:`SimulationResult`;
+* :func:`sweep`: a grid of loops into a resumable Parquet directory (``loopsim sweep``);
+  :func:`read_results`, :func:`read_snapshots` and :func:`coefficients` read it back;
+* :func:`summarize` and :func:`compare`: outcomes over seeds as distributions;
+* :func:`evaluate_maps`, :func:`stability_parameter`: the model's maps and q;
+* :class:`LoopsimWarning`: a result that is not resolved or not determined;
+* the ``loopsim`` command (``loopsim --help``, docs/cli.md).
+
+Internals, each layer importing only those above it: ``config``, ``validation``,
+``spectral``, ``dispatch``; ``models``; ``integrators``; ``batch``; ``diagnostics``,
+``shapes``, ``stability``; ``io``; ``result``, ``api``, ``sweeps``, ``summary``, ``figures``,
+``cli``.
 """
 from . import _signals
 
@@ -23,7 +32,7 @@ from ._version import __version__  # noqa: E402
 #: that ``import loopsim.cli`` (``loopsim --help``) loads neither NumPy nor Numba.
 _EXPORTS = {
     "simulate": "api", "SimulationResult": "api", "evaluate_maps": "api",
-    "SUMMARY_FIELDS": "api", "stability_parameter": "diagnostics",
+    "SUMMARY_FIELDS": "api", "LoopsimWarning": "api", "stability_parameter": "diagnostics",
     "coefficients": "io", "read_results": "io", "read_snapshots": "io", "sweep": "sweeps",
     "summarize": "summary", "compare": "summary",
     "animate": "figures.animation", "report": "sweep_report",

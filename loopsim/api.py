@@ -5,7 +5,6 @@ the arguments ``t_span``, ``t_eval``, ``rtol``, ``atol``, ``method``,
 ``first_step``, ``max_step``, ``min_step``, and the result's ``t``, ``y``,
 ``success``, ``status``, ``message``, ``nfev``, ``njev``, ``nlu``.
 """
-import dataclasses
 import math
 import time
 import warnings
@@ -19,156 +18,10 @@ from .config import (
     DEFAULT_SEED, DEFAULT_STEADY_INTERVAL, DEFAULT_T_END, DEFAULT_TAIL_TOL, DEFAULT_W,
 )
 from .diagnostics import stability_parameter
-
-SUMMARY_FIELDS = io.SUMMARY_FIELDS
-#: solve_ivp's status: -1 the integration failed, 0 it reached t_end, 1 it stopped
-#: early at a steady terminal state (a termination event).
-FAILED, REACHED_END, STOPPED_EARLY = -1, 0, 1
-
-
-@dataclasses.dataclass(repr=False)
-class SimulationResult:
-    """One trajectory: inputs, states at the requested times, the final state, statistics.
-
-    ``t`` holds exactly the requested times that were reached (``t_missed`` the
-    others, after an early stop or a failure); ``x[i]`` (3, 2 n_used + 1) are the
-    position coefficients at ``t[i]``, ``u[i]`` the velocity and
-    ``multiplier[i]`` (2n+1) the tension multiplier T there (``spectral``
-    layout); ``y`` is ``x`` flattened as solve_ivp's (n_state, n_times).  The
-    final state, at ``t_final``, is ``x_final``, ``u_final``,
-    ``multiplier_final``.  ``tension_profile(i)`` gives the physical axial
-    force N(s).  ``n_used`` is the truncation the run ended at (with ``n="auto"``
-    earlier states are zero-padded to it), ``tail_max`` the largest spectral tail met
-    at n_used.
-    """
-
-    inputs: dict
-    method: str
-    t: np.ndarray
-    x: np.ndarray
-    u: np.ndarray
-    multiplier: np.ndarray
-    t_missed: np.ndarray
-    t_final: float
-    x_final: np.ndarray
-    u_final: np.ndarray
-    multiplier_final: np.ndarray
-    status_code: int  # loopsim's detailed status (``integrators.STATUS_NAMES``)
-    steps_accepted: int
-    steps_rejected: int
-    nfev: int
-    njev: int
-    nlu: int
-    wall_s: float
-    length_error_max: float  # largest |relative length error| at accepted steps
-    n_used: int = None
-    tail_max: float = float("nan")
-    initial_info: dict = None  # diagnostics of a given initial shape (``shapes``), else None
-    aspect_ratio_initial: float = float("nan")
-    twin: dict = None  # the twin's end state and cost (``outcomes``), or None without one
-    compile_s: float = 0.0  # kernel compilation during the call, not counted in wall_s
-    thresholds: outcomes.Thresholds = outcomes.Thresholds()
-
-    @property
-    def success(self):
-        return self.status_code in integrators.SUCCESS
-
-    @property
-    def status(self):
-        """-1 failed, 0 reached t_end, 1 stopped early at a steady state (as solve_ivp)."""
-        if not self.success:
-            return FAILED
-        return STOPPED_EARLY if self.status_code == integrators.STEADY else REACHED_END
-
-    @property
-    def message(self):
-        return {REACHED_END: "reached t_end", STOPPED_EARLY: "stopped early: steady state"}.get(
-            self.status, integrators.STATUS_NAMES[self.status_code])
-
-    @property
-    def stop_reason(self):
-        """'t_end', 'steady' (early stop at the terminal state) or the failure."""
-        return integrators.STOP_REASONS[self.status_code]
-
-    @property
-    def y(self):
-        return self.x.reshape(self.x.shape[0], -1).T
-
-    @property
-    def end_state(self):
-        """{regime, theta_final_deg, aspect_ratio} of the final state."""
-        return outcomes.end_state(self.inputs["theta0_deg"], self.aspect_ratio_initial,
-                                  self.x_final, self.success, self.thresholds)
-
-    @property
-    def regime(self):
-        return self.end_state["regime"]
-
-    @property
-    def resolved(self):
-        """Whether n_used resolves the run (``outcomes.Thresholds.resolved``)."""
-        return self.thresholds.resolved(self.length_error_max, self.tail_max)
-
-    @property
-    def determinacy(self):
-        """``outcomes.DETERMINACY_FIELDS``: determined (None without a twin), the run–twin
-        differences of terminal tilt and aspect ratio, the twin's RHS evaluations."""
-        if self.twin is None:
-            return dict(outcomes.NO_TWIN)
-        return outcomes.determinacy(self.end_state, self.twin, self.twin["nfev"],
-                                    self.thresholds)
-
-    @property
-    def determined(self):
-        return self.determinacy["determined"]
-
-    def __repr__(self):
-        d = self.determinacy
-        return (f"SimulationResult(g0={self.inputs['g0']:g}, theta0_deg="
-                f"{self.inputs['theta0_deg']:g}, n_used={self.n_used}, method={self.method!r}, "
-                f"message={self.message!r}, regime={self.regime!r}, resolved={self.resolved}, "
-                f"determined={d['determined']}, theta_final_deg="
-                f"{self.end_state['theta_final_deg']:.4g}, theta_uncertainty_deg="
-                f"{d['theta_uncertainty_deg']:.2g}, t_final={self.t_final:g}, "
-                f"times={len(self.t)}, nfev={self.nfev}, wall_s={self.wall_s:.3g})")
-
-    def warnings(self):
-        """Lines a user should read: the run is not resolved, or not determined."""
-        lines = []
-        if not self.resolved:
-            lines.append(
-                f"not resolved at n = {self.n_used} (length error up to "
-                f"{self.length_error_max:.2g}, limit {self.thresholds.resolved_length_error:g};"
-                f" spectral tail up to {self.tail_max:.2g}, limit "
-                f"{self.thresholds.resolved_tail:g}): the terminal tilt and shape are not "
-                "converged; increase n or use n auto")
-        if self.determined is False and self.success:  # a failure says so in its status
-            d = self.determinacy
-            lines.append(
-                f"outcome not determined: a twin run at {outcomes.TWIN_FACTOR:g}x stricter "
-                f"tolerances ends {d['theta_uncertainty_deg']:.2g} deg and "
-                f"{d['aspect_uncertainty']:.2g} in aspect ratio away (regime "
-                f"{self.twin['regime']!r}): the terminal tilt is a sample of an "
-                "ill-conditioned transient, not an outcome")
-        return lines
-
-    def tension_profile(self, i=None):
-        """(s, N(s)) at requested time i, or at the final state (default)."""
-        if i is None:
-            return diagnostics.tension_profile(self.x_final, self.multiplier_final)
-        return diagnostics.tension_profile(self.x[i], self.multiplier[i])
-
-    def summary(self):
-        """Dict with exactly the keys of ``SUMMARY_FIELDS`` (the final state's diagnostics
-        and what they mean)."""
-        return terminal_summary(
-            self.inputs, self.x_final, self.u_final, self.multiplier_final,
-            method=self.method, n_used=self.n_used,
-            status=integrators.STATUS_NAMES[self.status_code], t_final=self.t_final,
-            steps_accepted=self.steps_accepted, steps_rejected=self.steps_rejected,
-            nfev=self.nfev, njev=self.njev, nlu=self.nlu, wall_s=self.wall_s,
-            tail_max=self.tail_max, regime=self.regime, resolved=self.resolved,
-            **self.determinacy)
+from .result import (  # noqa: F401 - re-exported: loopsim.api is where users met them
+    FAILED, REACHED_END, STOPPED_EARLY, SUMMARY_FIELDS, LoopsimWarning, SimulationResult,
+    terminal_summary,
+)
 
 
 def ladder_top(model, n_max):
@@ -178,36 +31,62 @@ def ladder_top(model, n_max):
     return n_max if top is None else min(n_max, top)
 
 
-def terminal_summary(inputs, x, u, multiplier, **run_stats):
-    """Summary fields of a final shape x with velocity u and multiplier T.
-
-    ``inputs``: g0, theta0_deg, n, t_end, rtol, atol, w, perturbation, seed, model,
-    slenderness;
-    ``run_stats``: the ``io.RUN_FIELDS`` and ``io.OUTCOME_FIELDS``.
-    """
-    values = dict(inputs, **run_stats)
-    values["q0"] = stability_parameter(inputs["g0"], inputs["theta0_deg"])
-    values.update(diagnostics.evaluate(diagnostics.State(x, u, multiplier, inputs["g0"])))
-    return {key: values[key] for key in SUMMARY_FIELDS}
-
-
 def twin_end_state(method, g0, w, x0, t0, t_end, options, ladder, tail_tol, theta0_deg,
                    thresholds=outcomes.Thresholds(), model=models.LOCAL):
     """The end state of a run's twin (``outcomes``): the same start and method, every
     tolerance ``outcomes.TWIN_FACTOR`` times stricter.  Returns
     {regime, theta_final_deg, aspect_ratio, nfev, n_used}."""
     rtol, atol, tail_tol = outcomes.twin_tolerances(options.rtol, options.atol, tail_tol)
-    status, _, x, n_used, counts, _, _ = refinement.integrate_case(
+    run = refinement.integrate_case(
         method, g0, w, x0, t0, t_end, np.empty(0), options._replace(rtol=rtol, atol=atol),
         ladder, tail_tol, model)
-    end = outcomes.end_state(theta0_deg, diagnostics.aspect_ratio(x0), x,
-                             status in integrators.SUCCESS, thresholds)
-    return dict(end, nfev=int(counts[2]), n_used=int(n_used))
+    end = outcomes.end_state(theta0_deg, diagnostics.aspect_ratio(x0), run.x_final,
+                             run.status in integrators.SUCCESS, thresholds)
+    return dict(end, nfev=int(run.counts[integrators.COUNTS.index("nfev")]),
+                n_used=int(run.n_used))
 
 
 def evaluate_maps(x, g0, w=DEFAULT_W, *, model="local", slenderness=None):
-    """Velocity coefficients u (3, 2n+1) and multiplier T (2n+1) of shape x under ``model``
-    (``simulate``'s ``model`` and ``slenderness``)."""
+    """The velocity and the tension multiplier of a shape: the model's maps at one state.
+
+    Parameters
+    ----------
+    x : array_like
+        (3, 2n + 1) shape coefficients [a0, a1..an, b1..bn] per component, in L/2π.
+    g0 : float
+        Gravity over bending stiffness, L³ g ρ_L / (8π³ EI) (dimensionless).
+    w : float, default 10.0
+        Length-penalty rate, in 1/t_u.
+    model : {"local", "nonlocal"}, default "local"
+        The hydrodynamics (as in :func:`simulate`).
+    slenderness : float or None, default None
+        With ``model="nonlocal"``: ε = a/L (dimensionless).
+
+    Returns
+    -------
+    u : numpy.ndarray
+        (3, 2n + 1) velocity coefficients, in (L/2π)/t_u.
+    multiplier : numpy.ndarray
+        (2n + 1,) coefficients of the tension multiplier T, in EI (2π/L)².
+
+    Raises
+    ------
+    ValueError
+        ``x`` is not (3, 2n + 1) with finite values, or n is beyond the model's highest
+        order, or the model or slenderness is bad.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> import loopsim
+    >>> circle = np.zeros((3, 5))  # n = 2: [a0, a1, a2, b1, b2] per component
+    >>> circle[0, 3] = circle[1, 1] = 1.0  # x = sin s, y = cos s: a horizontal circle
+    >>> u, multiplier = loopsim.evaluate_maps(circle, 60.0)
+    >>> round(float(u[2, 0]), 6)  # it falls at u_z = -g0 (7 - cos 0) / 6 = -g0
+    -60.0
+    >>> round(float(multiplier[0]), 6)  # T = -1 + q cos s, q = 0 when horizontal
+    -1.0
+    """
     x = np.ascontiguousarray(x, dtype=float)
     n = shapes.check_coefficients(x, "x")
     model = models.choose(model, slenderness)
@@ -225,7 +104,7 @@ def velocity_and_multiplier(problem, x):
 
 
 def simulate(
-    g0, theta0_deg=None, *, n=None, t_span=(0.0, DEFAULT_T_END), t_eval=None,
+    g0, theta0_deg=None, *, n="auto", t_span=(0.0, DEFAULT_T_END), t_eval=None,
     snapshots=2, rtol=DEFAULT_RTOL, atol=DEFAULT_ATOL, w=DEFAULT_W,
     perturbation=None, seed=DEFAULT_SEED, method=None,
     max_steps=DEFAULT_MAX_STEPS, length_tol=DEFAULT_LENGTH_TOL, first_step=None,
@@ -233,35 +112,111 @@ def simulate(
     initial=None, initial_case_id=None, n_max=DEFAULT_N_MAX, tail_tol=DEFAULT_TAIL_TOL,
     n_start=None, twin=True, model="local", slenderness=None,
 ):
-    """Simulate a loop released as a perturbed circle tilted by ``theta0_deg``.
+    """Simulate one loop released as a perturbed circle tilted by ``theta0_deg`` (or from a
+    given shape), to a resolved terminal state by default.
 
-    Parameters follow ``scipy.integrate.solve_ivp`` where they overlap:
-    ``t_span`` (t0, t_end), ``t_eval`` (the output times, returned exactly;
-    default ``snapshots`` equally spaced times including both ends),
-    ``rtol``/``atol``, ``method`` (``integrators.METHODS`` or "auto"; default
-    "rkf45", the paper's scheme, at a fixed n and "auto" with ``n="auto"``), ``first_step``,
-    ``max_step``, ``min_step``.  ``steady_tol`` (default off) stops early at a
-    steady terminal state (``integrators.step_options``).  ``g0`` is gravity
-    over stiffness, ``w`` the length-penalty rate, ``perturbation`` the RMS
-    size of the seeded initial perturbation (``shapes.circle``; default 1e-3,
-    n = 6).  ``n="auto"`` starts at ``n_start`` (default 6, or a given shape's
-    order) and raises n up to ``n_max`` whenever the spectral tail
-    passes ``tail_tol`` (``loopsim.refinement``).  ``method="auto"`` picks the integrator for the case
-    (``refinement.auto_method``).  ``twin`` (default on) also runs the stricter twin
-    that says whether the outcome is determined (``loopsim.outcomes``; about doubles
-    the cost); ``result.warnings()`` lists what a user should know (also issued as
-    Python warnings).  ``model`` "local" (the paper's local slender-body theory, the
-    default) or "nonlocal" (full slender-body theory, docs/nonlocal.md) with
-    ``slenderness`` ε = a/L (filament radius over loop length); the nonlocal model's n must stay
-    below the first mode its operator is not positive at (``models.highest_order``; with
-    ``n="auto"`` the ladder stops there, whatever ``n_max``).
+    The arguments and the result follow ``scipy.integrate.solve_ivp`` where the two
+    overlap (``t_span``, ``t_eval``, ``rtol``, ``atol``, ``method``, ``first_step``,
+    ``max_step``, ``min_step``; ``t``, ``y``, ``success``, ``status``, ``message``,
+    ``nfev``).  Units: lengths in L/2π, times in t_u (docs/model.md, "Units").  The
+    default, ``n="auto"``, restarts the run from t0 at the next order whenever its spectral
+    tail passes ``tail_tol``; the paper's scheme is ``n=6, method="rkf45"``.
 
-    ``initial`` starts from a given shape instead of the tilted circle:
-    coefficients (3, 2m+1) or a path (point file or results, with
-    ``initial_case_id``); see ``shapes.start_shape`` for the defaults.
-    ``result.initial_info`` holds the shape's diagnostics.
+    Parameters
+    ----------
+    g0 : float
+        Gravity over bending stiffness, L³ g ρ_L / (8π³ EI) (dimensionless, >= 0).
+    theta0_deg : float or None, default None
+        Initial tilt of the loop's plane to the horizontal, in degrees, in [0, 90];
+        required unless ``initial`` is given (then None: the tilt is measured).
+    n : int or "auto", default "auto"
+        Fourier truncation order (1..128), or "auto": start at ``n_start`` and restart
+        the run from t0 at the next order of ``config.AUTO_ORDERS`` (up to ``n_max``)
+        whenever its spectral tail passes ``tail_tol`` (``loopsim.refinement``).
+    t_span : (float, float), default (0.0, 10.0)
+        Start and end time, in t_u.
+    t_eval : array_like or None, default None
+        Output times in t_u, strictly increasing within ``t_span`` (returned exactly);
+        None: ``snapshots`` equally spaced times including both ends.
+    snapshots : int, default 2
+        Number of output times when ``t_eval`` is None.
+    rtol : float, default 1e-6
+        Relative tolerance of the time integration (dimensionless).
+    atol : float, default 1e-9
+        Absolute tolerance on the shape coefficients, in L/2π.
+    w : float, default 10.0
+        Length-penalty rate of the inextensibility constraint, in 1/t_u.
+    perturbation : float or None, default None
+        RMS size of the seeded initial perturbation, in L/2π; None: 1e-3 for the tilted
+        circle, 0 for a given shape.
+    seed : int, default 0
+        Seed of the perturbation.
+    method : {"rkf45", "radau5", "auto"} or None, default None
+        The integrator; None: "auto" with ``n="auto"`` (chosen for the case,
+        ``refinement.auto_method``) and "rkf45" (the paper's) at a fixed n.
+    max_steps : int, default 2000000
+        Most time steps.
+    length_tol : float, default 0.25
+        Relative length error (dimensionless) at which the run stops as failed.
+    first_step, max_step, min_step : float or None, default None, inf, 0.0
+        Step-size limits, in t_u (None: chosen by the integrator).
+    steady_tol : float or None, default None
+        Stop early once the shape and tilt change by less than this (dimensionless) per
+        ``steady_interval``; None: integrate to ``t_span[1]``.
+    steady_interval : float, default 0.5
+        Interval of the steady-state test, in t_u.
+    initial : array_like, str or None, default None
+        Start from a given shape instead of the tilted circle: coefficients (3, 2m + 1)
+        in L/2π, a point file (CSV/Parquet, columns x, y, z; fitted by arc length and
+        scaled to length 2π) or results (a ``run --out`` file, a sweep directory).  With
+        ``n="auto"`` a point file starts at the lowest order whose truncation of the fit
+        leaves out at most ``config.INITIAL_CONTENT_TOL`` (1e-12) of its RMS amplitude
+        (at least 6, at most the ladder's top), coefficients and results at their own
+        order; every order of the ladder starts from that same shape.
+    initial_case_id : int or None, default None
+        The case of a results ``initial`` holding several.
+    n_max : int, default 32
+        With ``n="auto"``: the highest order (also capped by the model's, for nonlocal).
+    tail_tol : float, default 1e-5
+        With ``n="auto"``: the spectral-tail tolerance (dimensionless).
+    n_start : int or None, default None
+        With ``n="auto"``: the first order; None: 6, or a given shape's (see ``initial``).
+    twin : bool, default True
+        Also run the twin at 10x stricter tolerances that says whether the outcome is
+        determined (``loopsim.outcomes``; about doubles the cost).
+    model : {"local", "nonlocal"}, default "local"
+        The paper's local slender-body theory, or full slender-body theory
+        (docs/nonlocal.md), whose n must stay below its highest order
+        (``models.highest_order``).
+    slenderness : float or None, default None
+        With ``model="nonlocal"``: ε = a/L, filament radius over loop length
+        (dimensionless, in (0, 0.05]).
 
-    Never raises for a failed integration: see ``result.success``.
+    Returns
+    -------
+    SimulationResult
+        The trajectory at the output times, the final state, the outcome (``regime``,
+        ``resolved``, ``determined``) and the cost.  A failed integration is a result
+        too: see ``result.success``.
+
+    Raises
+    ------
+    ValueError
+        A bad argument (named in the message), ``theta0_deg`` with ``initial`` or neither,
+        an unreadable or degenerate initial shape, ``n_start`` without ``n="auto"``, or n
+        beyond the model's highest order.
+
+    Warns
+    -----
+    LoopsimWarning
+        The result is not resolved, or not determined (``SimulationResult.warnings``).
+
+    Examples
+    --------
+    >>> import loopsim
+    >>> result = loopsim.simulate(150, 45)  # doctest: +SKIP
+    >>> result.resolved, result.n_used, result.regime  # doctest: +SKIP
+    >>> paper = loopsim.simulate(150, 45, n=6, method="rkf45")  # doctest: +SKIP
     """
     g0 = validation.check_real("g0", g0, low=0.0)
     model = models.choose(model, slenderness)
@@ -273,9 +228,16 @@ def simulate(
     if refine:
         validation.check_choice("n", n, ("auto",))
     if refine:
-        n = n_start if n_start is not None else (
-            refinement.AUTO_START if initial is None else None)
         n_max = validation.check_order("n_max", n_max)
+        if n_start is not None:
+            n = n_start
+        elif initial is None:
+            n = refinement.AUTO_START
+        else:  # a point file at the order its content needs; a stored shape at its own
+            n = shapes.auto_start_order(initial, initial_case_id, refinement.AUTO_START,
+                                        ladder_top(model, n_max))
+    elif n is None:
+        raise ValueError("n must be an order (1..128) or 'auto', got None")
     elif n_start is not None:
         raise ValueError("n_start applies only with n='auto'")
     if n is not None:
@@ -318,8 +280,9 @@ def simulate(
         steady_interval if steady_tol is not None else 0.0, steady_tol or 0.0)
     compiled = _jitcache.compile_seconds()
     start = time.perf_counter()
-    status, t_final, x_final, n_used, counts, worst, x_out = refinement.integrate_case(
+    run = refinement.integrate_case(
         method_object, g0, w, x0, t0, t_end, t_eval, options, ladder, tail_tol, model)
+    status, t_final, x_final, n_used, counts, worst, x_out = run
     twin_state = None
     if twin and status in integrators.SUCCESS:
         twin_state = twin_end_state(method_object, g0, w, x0, t0, t_end, options, ladder,
@@ -330,7 +293,8 @@ def simulate(
     compile_s = _jitcache.compile_seconds() - compiled
     wall = time.perf_counter() - start - compile_s
     if twin_state is not None:  # the twin's time is not the run's: split by RHS evaluations
-        wall *= float(counts[2]) / (counts[2] + twin_state["nfev"])
+        nfev = int(counts[integrators.COUNTS.index("nfev")])
+        wall *= float(nfev) / (nfev + twin_state["nfev"])
 
     problem = models.make_problem(model, n_used, g0, w)
     reached = t_eval <= t_final
@@ -351,8 +315,3 @@ def simulate(
     for line in result.warnings():
         warnings.warn(line, LoopsimWarning, stacklevel=2)
     return result
-
-
-class LoopsimWarning(UserWarning):
-    """A result that needs care: not resolved, or not determined
-    (``SimulationResult.warnings``)."""

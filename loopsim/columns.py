@@ -1,11 +1,14 @@
 """Every column loopsim writes, declared once: its unit and what it means.
 
-The units are those of the dimensionless equations (``loopsim.config``): lengths in
-L/2π (the loop has length 2π), time in the paper's time unit t_u (§3), forces in
-EI (2π/L)², angles in degrees at the interface.  The declarations go into each Parquet
-field's metadata (keys ``unit`` and ``description``), into ``_sweep.json`` and a
-results frame's ``attrs["loopsim"]["columns"]``, and into the docs' column table
-(``python -m loopsim.columns`` prints it as Markdown).
+The units are those of the dimensionless equations (``loopsim.config``; docs/model.md,
+"Units"): lengths in L/2π (the loop has length 2π), time in
+t_u = ζ⊥ (L/2π)⁴ / EI (ζ⊥ = 8πμ/c the perpendicular drag coefficient per unit length),
+forces (the axial force N, the multiplier T) in EI (2π/L)², force densities in
+EI (2π/L)³ = 8π³EI/L³, angles in degrees at the interface.  The declarations go into
+each Parquet field's metadata (keys ``unit`` and ``description``), into ``_sweep.json``
+and a results frame's ``attrs["loopsim"]["columns"]``, and into the docs' column table
+(``python -m loopsim.columns [results|trajectory|summary|compare|stops]`` prints one
+as Markdown).
 """
 LENGTH = "L/2pi"
 TIME = "t_u"
@@ -16,6 +19,7 @@ DEG = "deg"
 COUNT = "count"
 TEXT = "text"
 FLAG = "bool"
+PROBABILITY = "1 (probability)"
 
 #: name: (unit, description) of every column of a sweep's result files, in file order.
 RESULT_COLUMNS = {
@@ -102,6 +106,86 @@ TRAJECTORY_COLUMNS = {
 }
 
 
+#: name: (unit, description) of every column a summary table (``loopsim.summarize``,
+#: ``loopsim summary --out``) may hold: the cell's inputs (those of :data:`RESULT_COLUMNS`
+#: that define its cells), then the statistics over its seeds.
+SUMMARY_COLUMNS = {
+    **{name: RESULT_COLUMNS[name] for name in (
+        "g0", "theta0_deg", "model", "slenderness", "n", "t_end", "rtol", "atol", "w",
+        "perturbation", "method")},
+    "seeds": (COUNT, "rows (seeds) in the cell"),
+    "resolved": (COUNT, "rows of the cell whose n_used resolves them"),
+    "determined": (COUNT, "rows of the cell whose outcome is determined (a twin agreed)"),
+    **{f"p_{regime}{end}": (PROBABILITY, f"{what} of the regime {label}")
+       for regime, label in (("stable", "stable"), ("in_plane", "in-plane"), ("3d", "3d"),
+                             ("failed", "failed"))
+       for end, what in (("", "share of the cell's rows"),
+                         ("_low", "lower end of the 95% Wilson score interval of the share"),
+                         ("_high", "upper end of the 95% Wilson score interval of the share"))},
+    **{f"{short}_{stat}": (unit, f"{what} of the cell's {label}")
+       for short, unit, label in (("tilt", DEG, "terminal tilts (theta_final_deg)"),
+                                  ("aspect", ONE, "terminal aspect ratios"),
+                                  ("q_final", ONE, "terminal q = g0 sin(theta_final) / 3"))
+       for stat, what in (("q25", "lower quartile"), ("median", "median"),
+                          ("q75", "upper quartile"),
+                          ("median_low", "lower end of the median's 95% percentile-bootstrap "
+                                         "interval"),
+                          ("median_high", "upper end of the median's 95% percentile-bootstrap "
+                                          "interval"))},
+    "nfev": (COUNT, "right-hand-side evaluations of the cell's runs, summed"),
+    "twin_nfev": (COUNT, "right-hand-side evaluations of the cell's twins, summed"),
+    "wall_s": ("s", "wall time of the cell's runs, summed (compilation and twins left out)"),
+}
+
+#: name: (unit, description) of every column of a comparison table (``loopsim.compare``,
+#: ``loopsim compare --out``): the pairing inputs, then the tests of one cell.
+COMPARE_COLUMNS = {
+    **{name: SUMMARY_COLUMNS[name] for name in (
+        "g0", "theta0_deg", "model", "slenderness", "n", "t_end", "rtol", "atol", "w",
+        "perturbation", "method")},
+    "seeds_a": (COUNT, "rows of the cell in the first table"),
+    "seeds_b": (COUNT, "rows of the cell in the second table"),
+    "tilt_ks_p": (PROBABILITY, "p-value of the two-sample Kolmogorov-Smirnov test of the "
+                               "terminal tilts"),
+    "aspect_ks_p": (PROBABILITY, "p-value of the two-sample Kolmogorov-Smirnov test of the "
+                                 "terminal aspect ratios"),
+    "tilt_wasserstein": (DEG, "1-Wasserstein distance between the two samples of terminal "
+                              "tilt"),
+    "tilt_wasserstein_low": (DEG, "lower end of its 95% percentile-bootstrap interval"),
+    "tilt_wasserstein_high": (DEG, "upper end of its 95% percentile-bootstrap interval"),
+    "regime_p": (PROBABILITY, "p-value of the chi-square test of the regime counts (1 when "
+                              "both samples hold one regime only)"),
+    "verdict": (TEXT, "different (a p-value below alpha / 3) or indistinguishable at this "
+                      "sample size"),
+}
+
+#: name: (unit, description) of every column of a ``--seeds auto`` stop table
+#: (``seeds_auto.parquet``): one row per cell.
+STOP_COLUMNS = {
+    "g0": RESULT_COLUMNS["g0"],
+    "theta0_deg": RESULT_COLUMNS["theta0_deg"],
+    "n": RESULT_COLUMNS["n"],
+    "perturbation": RESULT_COLUMNS["perturbation"],
+    "seeds": (COUNT, "seeds run for the cell"),
+    "rounds": (COUNT, "rounds the cell took part in"),
+    "stop_reason": (TEXT, "why the cell stopped: deterministic, sharp or cap (--max-seeds reached) "
+                          "(loopsim.seeding)"),
+    "p_halfwidth": (PROBABILITY, "largest half-width of the regime shares' 95% Wilson "
+                                 "intervals at the stop"),
+    "tilt_halfwidth_deg": (DEG, "half-width of the median terminal tilt's 95% bootstrap "
+                                "interval at the stop"),
+    "runs": (TEXT, "trajectories (each run twin-checked or deterministic) or samples (the "
+                   "cell's outcome is a distribution)"),
+    "twins": (COUNT, "rows of the cell with a twin run"),
+    "check_seeds": (COUNT, "seeds of the distribution check of a sampled cell (0: none)"),
+    "check_verdict": (TEXT, "the check's verdict (loopsim.compare; empty: no check)"),
+    "check_tilt_ks_p": COMPARE_COLUMNS["tilt_ks_p"],
+    "check_aspect_ks_p": COMPARE_COLUMNS["aspect_ks_p"],
+    "check_regime_p": COMPARE_COLUMNS["regime_p"],
+    "check_tilt_wasserstein": COMPARE_COLUMNS["tilt_wasserstein"],
+}
+
+
 def field_metadata(name, table=RESULT_COLUMNS):
     """Parquet field metadata of a column: {b"unit": ..., b"description": ...}."""
     unit, description = table[name]
@@ -118,5 +202,11 @@ def markdown(table=RESULT_COLUMNS):
     return "\n".join(lines)
 
 
+#: The tables ``python -m loopsim.columns [NAME]`` prints.
+TABLES = {"results": RESULT_COLUMNS, "trajectory": TRAJECTORY_COLUMNS,
+          "summary": SUMMARY_COLUMNS, "compare": COMPARE_COLUMNS, "stops": STOP_COLUMNS}
+
 if __name__ == "__main__":
-    print(markdown())
+    import sys
+
+    print(markdown(TABLES[sys.argv[1] if len(sys.argv) > 1 else "results"]))

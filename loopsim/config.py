@@ -2,9 +2,12 @@
 
 Conventions used throughout loopsim (stated once, tested in ``tests/``):
 
-* Lengths are scaled by L / 2π, so the loop has length 2π and arc length
-  s ∈ [0, 2π).  Forces are scaled by 8π³EI / L³ (per unit length, per L³),
-  time so that the dimensionless equations read (paper §3)::
+* Lengths are scaled by ℓ = L / 2π, so the loop has length 2π and arc length
+  s ∈ [0, 2π).  Force densities are scaled by EI/ℓ³ = 8π³EI / L³, forces (the
+  multiplier T, the axial force N) by EI/ℓ² = EI (2π/L)², and time by
+  t_u = ζ⊥ ℓ⁴ / EI (ζ⊥ = 8πμ/c, c = −2 ln(a/L): the perpendicular drag coefficient per
+  unit length), so that the dimensionless equations read (paper §3; docs/model.md,
+  "Units")::
 
       f = -x'''' + (T x')' - g0 e_z
       u = f + (x'·f) x'
@@ -95,6 +98,13 @@ MODEL_CHOICES = ("local", "nonlocal")
 #: from mode 1 on (docs/nonlocal.md, "High modes"); slender-body theory needs ε ≪ 1.
 MAX_SLENDERNESS = 0.05
 DEFAULT_TAIL_TOL = RESOLVED_TAIL
+#: A point file started with ``n="auto"`` (``--initial POINTS --n auto``) starts at the
+#: lowest order whose truncation of the fitted curve leaves out at most this RMS amplitude
+#: relative to the loop's (``shapes.content_order``): 1000 times below the default atol
+#: (1e-9, in L/2π, on a loop of size about 1), so the start is the file's shape to within
+#: the integration's own error; a curve whose fit is at round-off (about 2e-15) by a lower
+#: order starts there.
+INITIAL_CONTENT_TOL = 1e-12
 #: ``--seeds auto``'s targets, by option name (``--p-halfwidth``, ``sweep(p_halfwidth=)``):
 #: (``seeding.SeedTargets`` field, default).  The defaults are defended in
 #: docs/distributions.md, "Seeds until the answer is sharp".

@@ -132,7 +132,32 @@ def tension_extremes(x, multiplier):
 
 
 def stability_parameter(g0, theta_deg):
-    """q = g0 sin θ / 3 (paper §4), θ in degrees."""
+    """The stability parameter q = g0 sin θ / 3 of a loop tilted by θ (paper §4).
+
+    Parameters
+    ----------
+    g0 : float
+        Gravity over bending stiffness, L³ g ρ_L / (8π³ EI) (dimensionless).
+    theta_deg : float
+        Tilt of the loop's plane to the horizontal, in degrees.
+
+    Returns
+    -------
+    float
+        q (dimensionless): the translating circle loses stability in plane at
+        q = 8.90 and out of plane at q = 10.65 (docs/stability.md).
+
+    Raises
+    ------
+    TypeError
+        ``g0`` or ``theta_deg`` is not a real number.
+
+    Examples
+    --------
+    >>> import loopsim
+    >>> round(loopsim.stability_parameter(150, 30), 6)
+    25.0
+    """
     return g0 * math.sin(math.radians(theta_deg)) / 3.0
 
 

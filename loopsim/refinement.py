@@ -21,6 +21,8 @@ Everything here is orchestration of the compiled driver, level by level: a level
 is one call of ``integrators.integrate`` (one case) or ``batch.integrate_cases``
 (many cases in parallel).
 """
+import typing
+
 import numpy as np
 
 from . import batch, integrators, models, spectral, validation
@@ -60,12 +62,35 @@ def level_options(options, tail_tol, top):
     return options._replace(resolution_tol=np.inf if top else float(tail_tol))
 
 
+class CaseRun(typing.NamedTuple):
+    """What :func:`integrate_case` returns (a tuple: it unpacks in this order)."""
+
+    status: int  #: ``integrators.STATUS_NAMES`` code of the last level
+    t_final: float  #: time reached, in t_u
+    x_final: np.ndarray  #: (3, 2 n_used + 1) terminal coefficients, in L/2π
+    n_used: int  #: the last order reached
+    counts: np.ndarray  #: ``integrators.COUNTS``, summed over the levels
+    worst: np.ndarray  #: [largest length error, largest spectral tail] of the last level
+    x_out: np.ndarray  #: (len(t_eval), 3, 2 n_used + 1) states at t_eval (NaN: not reached)
+
+
+class CasesRun(typing.NamedTuple):
+    """What :func:`integrate_cases` returns, per case b (a tuple: it unpacks in this order)."""
+
+    x_final: list  #: B arrays (3, 2 n_used[b] + 1), in L/2π
+    n_used: np.ndarray  #: (B,) the last order each case reached
+    t_final: np.ndarray  #: (B,) time reached, in t_u
+    status: np.ndarray  #: (B,) ``integrators.STATUS_NAMES`` codes
+    counts: np.ndarray  #: (B, len(integrators.COUNTS)), summed over the levels
+    worst: np.ndarray  #: (B, 2) largest length error and spectral tail of the last level
+
+
 def integrate_case(method, g0, w, x0, t0, t_end, t_eval, options, ladder, tail_tol,
                    model=models.LOCAL):
     """One case of ``model`` (``models.Model``) up the ladder (from x0 (3, 2 ladder[0] + 1)
     at t0), each order from t0.
 
-    Returns (status, t_final, x_final, n_used, counts, worst, x_out): counts as
+    Returns a :class:`CaseRun` (status, t_final, x_final, n_used, counts, worst, x_out): counts as
     ``integrators.integrate``, summed over the levels (the work of every level);
     worst = [largest length error, largest spectral tail] of the last level's run;
     n_used the last order reached; x_out (len(t_eval), 3, 2 n_used + 1) the states at
@@ -91,7 +116,7 @@ def integrate_case(method, g0, w, x0, t0, t_end, t_eval, options, ladder, tail_t
         counts += level_counts
         if status != REFINE:
             break
-    return int(status), float(t), y.reshape(3, -1), n, counts, worst[:2].copy(), x_out
+    return CaseRun(int(status), float(t), y.reshape(3, -1), n, counts, worst[:2].copy(), x_out)
 
 
 def integrate_cases(method, parameters, x0, t_end, options, ladder, tail_tol, cost=None,
@@ -100,7 +125,7 @@ def integrate_cases(method, parameters, x0, t_end, options, ladder, tail_tol, co
     order from t0.
 
     x0 (B, 3, 2 ladder[0] + 1); parameters (B, P) each case's
-    ``models.case_parameters``.  Returns (x_final,
+    ``models.case_parameters``.  Returns a :class:`CasesRun` (x_final,
     n_used, t_final, status, counts, worst): x_final a list of B arrays (3, 2 n_used
     + 1); counts summed over the levels; the others those of each case's last level.
     """
@@ -132,4 +157,4 @@ def integrate_cases(method, parameters, x0, t_end, options, ladder, tail_tol, co
             counts[b] += level_counts[row]
             worst[b] = level_worst[row][:2]
             n_used[b] = n
-    return x, n_used, t, status, counts, worst
+    return CasesRun(x, n_used, t, status, counts, worst)

@@ -120,8 +120,56 @@ def _cell_row(rows, seed):
 
 
 def summarize(frame, by=None, seed=0):
-    """One row per cell of a results table (``read_results``): see the module docstring.
-    ``by``: the cell columns (default :func:`cell_columns`); ``seed``: the bootstrap's."""
+    """Outcomes as distributions: one row per cell of a results table, from its seeds.
+
+    A cell is one point of the sweep's inputs with the seed left out: ``g0``,
+    ``theta0_deg`` and every other input of :data:`CELL_INPUTS` that takes more than one
+    value in the table.  A cell holds each seed at most once (two rows with one seed
+    differ in an input the table does not record, such as an ``initial`` shape, and are
+    refused rather than merged).
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        A results table (:func:`loopsim.read_results`), with at least ``regime``,
+        ``resolved``, ``determined`` and the cell columns.
+    by : list of str or None, default None
+        The columns that define the cells; None: :func:`cell_columns` (g0, theta0_deg and
+        every other input that varies).
+    seed : int, default 0
+        Seed of the bootstrap's generator (the table is reproducible bit for bit).
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per cell, sorted by its inputs, with the columns of
+        ``loopsim.columns.SUMMARY_COLUMNS``:
+
+        * ``seeds``, ``resolved``, ``determined``: how many rows, and how many of them
+          are resolved and determined;
+        * ``p_<regime>`` for each regime (stable, in_plane, 3d, failed), with its 95 %
+          Wilson score interval ``p_<regime>_low``, ``p_<regime>_high``:
+          (p̂ + z²/2N ± z sqrt(p̂(1 − p̂)/N + z²/4N²)) / (1 + z²/N), z = Φ⁻¹(0.975);
+        * the quartiles of the terminal tilt (degrees), aspect ratio and q
+          (``tilt_*``, ``aspect_*``, ``q_final_*``), each median with a 95 %
+          percentile-bootstrap interval (:data:`BOOTSTRAP_RESAMPLES` resamples);
+        * the cost: ``nfev``, ``twin_nfev`` and ``wall_s`` (seconds) summed.
+
+        ``table.attrs["loopsim_summary"]`` records the cell columns and the bootstrap.
+
+    Raises
+    ------
+    ValueError
+        A column of ``by`` is missing, ``frame`` has no rows, or a cell holds one seed
+        twice (the message names the cell).
+
+    Examples
+    --------
+    >>> import loopsim
+    >>> rows = loopsim.read_results("runs/seeds")  # doctest: +SKIP
+    >>> loopsim.summarize(rows)[["g0", "theta0_deg", "seeds", "p_3d", "p_3d_low",
+    ...                          "p_3d_high", "tilt_median"]]  # doctest: +SKIP
+    """
     by = list(cell_columns(frame) if by is None else by)
     missing = [c for c in by if c not in frame]
     if missing:
@@ -230,12 +278,49 @@ def wasserstein_interval(x, y, resamples=BOOTSTRAP_RESAMPLES, seed=0, level=0.95
 
 
 def compare(a, b, by=None, alpha=0.05, seed=0, resamples=500):
-    """Per cell of two results tables (the same cells at, say, n = 24 and n = 32, or two
+    """Whether two results tables of the same cells differ in distribution, cell by cell.
+
+    For each cell both tables hold (the same cells at, say, n = 24 and n = 32, or at two
     tolerances): two-sample Kolmogorov-Smirnov tests of the terminal tilt and aspect
-    ratio, the tilt's Wasserstein distance with a bootstrap interval, a chi-square test
-    of the regime counts, and a verdict: ``DIFFERENT`` when any of the three p-values is
-    below alpha / 3 (Bonferroni), else ``SAME``.  ``by``: the columns pairing the cells
-    (default g0, theta0_deg and the inputs both tables sweep alike)."""
+    ratio, the tilt's 1-Wasserstein distance with a bootstrap interval, a chi-square test
+    of the regime counts, and a verdict: :data:`DIFFERENT` when any of the three p-values
+    is below alpha / 3 (Bonferroni), else :data:`SAME`.
+
+    Parameters
+    ----------
+    a, b : pandas.DataFrame
+        Results tables (:func:`loopsim.read_results`) with ``theta_final_deg``,
+        ``aspect_ratio``, ``regime`` and the pairing columns.
+    by : list of str or None, default None
+        The columns that pair the cells; None: g0, theta0_deg and every input of
+        :data:`CELL_INPUTS` that varies within either table.
+    alpha : float, default 0.05
+        Significance level of the verdict (a probability, over the three tests).
+    seed : int, default 0
+        Seed of the bootstrap's generator.
+    resamples : int, default 500
+        Bootstrap resamples of the Wasserstein interval.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per shared cell, with the columns of ``loopsim.columns.COMPARE_COLUMNS``:
+        ``seeds_a``, ``seeds_b``, ``tilt_ks_p``, ``aspect_ks_p``, ``tilt_wasserstein``
+        (degrees) and its interval, ``regime_p``, ``verdict``.
+        ``table.attrs["loopsim_compare"]`` records the pairing and the bootstrap.
+
+    Raises
+    ------
+    ValueError
+        A pairing column is missing from either table, or the tables share no cell.
+
+    Examples
+    --------
+    >>> import loopsim
+    >>> a = loopsim.read_results("runs/seeds_n24")  # doctest: +SKIP
+    >>> b = loopsim.read_results("runs/seeds_n32")  # doctest: +SKIP
+    >>> loopsim.compare(a, b)[["g0", "theta0_deg", "tilt_ks_p", "verdict"]]  # doctest: +SKIP
+    """
     from scipy.stats import chi2_contingency, ks_2samp
 
     by, pairs = _paired_cells(a, b, by)

@@ -11,8 +11,8 @@ import os
 import subprocess
 import sys
 
-RUN = ["run", "--g0", "60", "--theta0", "30", "--t-end", "0.01"]
-SWEEP = ["sweep", "--g0", "60", "--theta0", "30", "--t-end", "0.01"]
+RUN = ["run", "--n", "6", "--g0", "60", "--theta0", "30", "--t-end", "0.01"]
+SWEEP = ["sweep", "--n", "6", "--g0", "60", "--theta0", "30", "--t-end", "0.01"]
 
 
 def cases(d):
@@ -33,26 +33,26 @@ def cases(d):
         bad.append((f"run {flag} {value}", RUN + [flag, value]))
     bad += [
         ("run unknown option", RUN + ["--bogus"]),
-        ("run without --theta0", ["run", "--g0", "60"]),
+        ("run without --theta0", ["run", "--n", "6", "--g0", "60"]),
         ("run --theta0 and --initial", RUN + ["--initial", f("short.csv")]),
-        ("run --initial missing", ["run", "--g0", "60", "--initial", f("missing.csv")]),
-        ("run --initial empty", ["run", "--g0", "60", "--initial", f("empty.csv")]),
-        ("run --initial 2 points", ["run", "--g0", "60", "--initial", f("short.csv")]),
-        ("run --initial no x,y,z", ["run", "--g0", "60", "--initial", f("nocols.csv")]),
-        ("run --initial NaN", ["run", "--g0", "60", "--initial", f("nan.csv")]),
-        ("run --initial fake parquet", ["run", "--g0", "60", "--initial", f("fake.parquet")]),
-        ("run --initial /dev/zero", ["run", "--g0", "60", "--initial", "/dev/zero"]),
-        ("run --initial FIFO", ["run", "--g0", "60", "--initial", f("fifo")]),
-        ("run --initial a directory", ["run", "--g0", "60", "--initial", d]),
+        ("run --initial missing", ["run", "--n", "6", "--g0", "60", "--initial", f("missing.csv")]),
+        ("run --initial empty", ["run", "--n", "6", "--g0", "60", "--initial", f("empty.csv")]),
+        ("run --initial 2 points", ["run", "--n", "6", "--g0", "60", "--initial", f("short.csv")]),
+        ("run --initial no x,y,z", ["run", "--n", "6", "--g0", "60", "--initial", f("nocols.csv")]),
+        ("run --initial NaN", ["run", "--n", "6", "--g0", "60", "--initial", f("nan.csv")]),
+        ("run --initial fake parquet", ["run", "--n", "6", "--g0", "60", "--initial", f("fake.parquet")]),
+        ("run --initial /dev/zero", ["run", "--n", "6", "--g0", "60", "--initial", "/dev/zero"]),
+        ("run --initial FIFO", ["run", "--n", "6", "--g0", "60", "--initial", f("fifo")]),
+        ("run --initial a directory", ["run", "--n", "6", "--g0", "60", "--initial", d]),
         ("run --out missing dir", RUN + ["--out", f("nodir/x.parquet")]),
         ("run --out a directory", RUN + ["--out", d]),
         ("run --out empty", RUN + ["--out", ""]),
         ("run --case-id without --initial", RUN + ["--case-id", "3"]),
-        ("sweep --g0 1:2", ["sweep", "--g0", "1:2", "--theta0", "30", "--out", out]),
-        ("sweep --g0 1:2:0", ["sweep", "--g0", "1:2:0", "--theta0", "30", "--out", out]),
-        ("sweep --g0 1:2:1e9", ["sweep", "--g0", "1:2:1000000000", "--theta0", "30",
+        ("sweep --g0 1:2", ["sweep", "--n", "6", "--g0", "1:2", "--theta0", "30", "--out", out]),
+        ("sweep --g0 1:2:0", ["sweep", "--n", "6", "--g0", "1:2:0", "--theta0", "30", "--out", out]),
+        ("sweep --g0 1:2:1e9", ["sweep", "--n", "6", "--g0", "1:2:1000000000", "--theta0", "30",
                                 "--out", out]),
-        ("sweep --theta0 100", ["sweep", "--g0", "60", "--theta0", "100", "--out", out]),
+        ("sweep --theta0 100", ["sweep", "--n", "6", "--g0", "60", "--theta0", "100", "--out", out]),
         ("sweep --n 0", SWEEP + ["--n", "0", "--out", out]),
         ("sweep --n 6.5", SWEEP + ["--n", "6.5", "--out", out]),
         ("sweep --seeds 0", SWEEP + ["--seeds", "0", "--out", out]),
@@ -67,12 +67,12 @@ def cases(d):
         ("sweep --out empty", SWEEP + ["--out", ""]),
         ("sweep --out a file", SWEEP + ["--out", f("short.csv")]),
         ("sweep --figure missing dir", SWEEP + ["--out", out, "--figure", f("nodir/p.png")]),
-        ("sweep --cases missing", ["sweep", "--cases", f("missing.csv"), "--out", out]),
-        ("sweep --cases theta0 abc", ["sweep", "--cases", f("cases_bad.csv"), "--out", out]),
-        ("sweep --cases n 6.5", ["sweep", "--cases", f("cases_frac.csv"), "--out", out]),
-        ("sweep --cases seed -1", ["sweep", "--cases", f("cases_seed.csv"), "--out", out]),
-        ("sweep --cases /dev/zero", ["sweep", "--cases", "/dev/zero", "--out", out]),
-        ("sweep --cases and --g0", ["sweep", "--cases", f("cases_seed.csv"), "--g0", "1",
+        ("sweep --cases missing", ["sweep", "--n", "6", "--cases", f("missing.csv"), "--out", out]),
+        ("sweep --cases theta0 abc", ["sweep", "--n", "6", "--cases", f("cases_bad.csv"), "--out", out]),
+        ("sweep --cases n 6.5", ["sweep", "--n", "6", "--cases", f("cases_frac.csv"), "--out", out]),
+        ("sweep --cases seed -1", ["sweep", "--n", "6", "--cases", f("cases_seed.csv"), "--out", out]),
+        ("sweep --cases /dev/zero", ["sweep", "--n", "6", "--cases", "/dev/zero", "--out", out]),
+        ("sweep --cases and --g0", ["sweep", "--n", "6", "--cases", f("cases_seed.csv"), "--g0", "1",
                                     "--out", out]),
         ("sweep --rerun-failed missing", ["sweep", "--rerun-failed", f("missing")]),
         ("stability --n 2", ["stability", "--n", "2"]),

@@ -32,8 +32,8 @@ import time
 import pandas as pd
 
 import loopsim
-from loopsim import config, io, refinement, shapes, spectral, sweeps
-from loopsim.cli.common import print_and_write, save_distribution_figure
+from loopsim import columns, config, io, refinement, shapes, spectral, sweeps
+from loopsim.cli.common import directory_name, print_and_write, save_distribution_figure
 
 #: What the second step varies, and the tolerances of ``--check tolerance``.
 CHECKS = ("tolerance", "resolution")
@@ -63,7 +63,7 @@ def same_start_run(g0, theta0_deg, seed, n):
     with the sweep's defaults and early stop, no twin: its summary row."""
     start = shapes.initial_shape(refinement.AUTO_START, math.radians(theta0_deg),
                                  config.DEFAULT_PERTURBATION, seed)
-    result = loopsim.simulate(g0, None, initial=spectral.resize(start, n), method="auto",
+    result = loopsim.simulate(g0, None, initial=spectral.resize(start, n), n=n, method="auto",
                               twin=False, steady_tol=config.DEFAULT_STEADY_TOL,
                               steady_interval=config.DEFAULT_STEADY_INTERVAL)
     # the cell's inputs as given (the measured tilt differs from them by the perturbation)
@@ -179,8 +179,9 @@ def main():
           f"{rows['wall_s'].sum():.0f} s summed case time; "
           f"{args.check} check of {len(checked)} points: {check_s:.0f} s")
     print_and_write(cells, os.path.join(args.runs, "summary.parquet"),
-                    dict(cells.attrs["loopsim_summary"], summary_of=os.path.abspath(auto_dir)),
-                    ["g0", "theta0_deg", "seeds", "p_3d", "tilt_median"])
+                    dict(cells.attrs["loopsim_summary"], summary_of=directory_name(auto_dir)),
+                    ["g0", "theta0_deg", "seeds", "p_3d", "tilt_median"],
+                    declarations=columns.SUMMARY_COLUMNS)
     print("\n" + markdown(stops, ["g0", "theta0_deg", "seeds", "rounds", "stop_reason",
                                   "p_halfwidth", "tilt_halfwidth_deg"],
                           {"p_halfwidth": "{:.3f}", "tilt_halfwidth_deg": "{:.2f}"}))
@@ -196,7 +197,8 @@ def main():
     print(reading.to_string(index=False, float_format=lambda v: f"{v:.3g}"))
     if comparison is not None:
         print_and_write(comparison, os.path.join(args.runs, f"compare-{args.check}.parquet"),
-                        dict(compared=f"{args.check} check"), ["g0", "theta0_deg", "verdict"])
+                        dict(compared=f"{args.check} check"), ["g0", "theta0_deg", "verdict"],
+                        declarations=columns.COMPARE_COLUMNS)
         print("\n" + markdown(comparison, ["g0", "theta0_deg", "seeds_a", "seeds_b",
                                            "tilt_ks_p", "aspect_ks_p", "regime_p",
                                            "tilt_wasserstein", "verdict"],

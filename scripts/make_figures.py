@@ -177,7 +177,7 @@ def steps(runs, threads, quick=False, n24=False):
         sweep("seeds_n6", "--g0", "150", "--theta0", "60", "--n", "6", "--seeds", seeds_n6, *lean),
         sweep("seeds_auto", "--g0", "150", "--theta0", "60", "--seeds", seeds_auto, *resolved,
               *lean, *one, capped=True),
-        sweep("phase_n6", *grid, *lean),
+        sweep("phase_n6", *grid, "--n", "6", *lean),
         sweep("phase_n4", *grid, "--n", "4", *lean),
         sweep("phase_n8", *grid, "--n", "8", "--method", "radau5", *lean),
         sweep("resolved_auto", "--cases", os.path.join(fig, "resolved_cases.csv"), *resolved,

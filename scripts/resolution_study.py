@@ -35,7 +35,8 @@ def main():
             x0 = shapes.initial_shape(args.n, math.radians(theta0), 1e-3, 0)
             runs = {}
             for n in (args.n, args.n_ref):
-                runs[n] = loopsim.simulate(g0, None, initial=spectral.resize(x0, n), t_span=(0, args.t_end),
+                runs[n] = loopsim.simulate(g0, None, initial=spectral.resize(x0, n), n=n,
+                                           t_span=(0, args.t_end),
                                            rtol=1e-8, atol=1e-11, method="radau5")
             low, ref = (runs[n].summary() for n in (args.n, args.n_ref))
             row = dict(g0=g0, theta0=theta0, q0=loopsim.stability_parameter(g0, theta0),

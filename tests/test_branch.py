@@ -128,7 +128,8 @@ def test_exchange_of_stability_and_neutral_modes_along_the_branch():
 def _run_from(shape, theta0_deg, t_end, perturbation=0.0):
     th = math.radians(theta0_deg)
     x0 = branch.tilt_shape(shape.x, th)
-    result = loopsim.simulate(3.0 * shape.q / math.sin(th), initial=x0, t_span=(0.0, t_end),
+    result = loopsim.simulate(3.0 * shape.q / math.sin(th), initial=x0,
+                              n=(x0.shape[1] - 1) // 2, t_span=(0.0, t_end),
                               method="radau5", rtol=1e-10, atol=1e-12, perturbation=perturbation,
                               seed=3)
     assert result.success

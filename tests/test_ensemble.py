@@ -59,7 +59,7 @@ def test_sweep_marks_under_resolved_cases(tmp_path, capsys):
     """n = 6: a stable loop is resolved; g0 = 150, θ0 = 60° (3D) is not (its length
     error exceeds 1e-2 by t = 3), and the sweep's summary line says so."""
     out = tmp_path / "res"
-    assert main(["sweep", "--g0", "30,150", "--theta0", "30,60", "--t-end", "3", "--quiet",
+    assert main(["sweep", "--n", "6", "--g0", "30,150", "--theta0", "30,60", "--t-end", "3", "--quiet",
                  "--out", str(out)]) == 0
     frame = loopsim.read_results(str(out))
     by_case = frame.set_index(["g0", "theta0_deg"])
@@ -164,10 +164,10 @@ def test_changed_configuration_is_refused(tmp_path):
 
 
 @pytest.mark.parametrize("argv, word", [
-    (["sweep", "--g0", "1:2", "--theta0", "30", "--out", "X"], "--g0"),
-    (["sweep", "--g0", "10", "--theta0", "95", "--out", "X"], "theta0_deg"),
-    (["sweep", "--cases", "/nonexistent/cases.csv", "--out", "X"], "cases.csv"),
-    (["sweep", "--g0", "10", "--out", "X"], "--theta0"),
+    (["sweep", "--n", "6", "--g0", "1:2", "--theta0", "30", "--out", "X"], "--g0"),
+    (["sweep", "--n", "6", "--g0", "10", "--theta0", "95", "--out", "X"], "theta0_deg"),
+    (["sweep", "--n", "6", "--cases", "/nonexistent/cases.csv", "--out", "X"], "cases.csv"),
+    (["sweep", "--n", "6", "--g0", "10", "--out", "X"], "--theta0"),
 ])
 def test_sweep_bad_input(argv, word, tmp_path, capsys):
     argv = [str(tmp_path / a) if a == "X" else a for a in argv]
@@ -268,7 +268,7 @@ def test_auto_sweep_records_orders_and_methods_and_is_reproducible(tmp_path):
 
 
 def test_snapshots_for_unknown_case_is_refused(tmp_path, capsys):
-    code = main(["sweep", "--g0", "10", "--theta0", "30", "--snapshots-for", "5",
+    code = main(["sweep", "--n", "6", "--g0", "10", "--theta0", "30", "--snapshots-for", "5",
                  "--out", str(tmp_path / "s")])
     err = capsys.readouterr().err
     assert code == 2 and "case 5" in err
@@ -339,7 +339,7 @@ def test_cases_file_cells_are_checked(tmp_path, capsys, content, words):
     """n = 6.5 is refused (it used to run n = 6), and a bad cell names row and column."""
     path = tmp_path / "cases.csv"
     path.write_text(content)
-    assert main(["sweep", "--cases", str(path), "--out", str(tmp_path / "s")]) == 2
+    assert main(["sweep", "--n", "6", "--cases", str(path), "--out", str(tmp_path / "s")]) == 2
     err = capsys.readouterr().err
     assert len(err.splitlines()) == 1 and all(word in err for word in words), err
     assert not (tmp_path / "s").exists()
@@ -347,7 +347,7 @@ def test_cases_file_cells_are_checked(tmp_path, capsys, content, words):
 
 def test_too_many_threads_refused_before_the_directory_is_made(tmp_path, capsys):
     out = tmp_path / "s"
-    assert main(["sweep", "--g0", "60", "--theta0", "30", "--threads", "1000",
+    assert main(["sweep", "--n", "6", "--g0", "60", "--theta0", "30", "--threads", "1000",
                  "--out", str(out)]) == 2
     assert "--threads" in capsys.readouterr().err and not out.exists()
 
@@ -359,7 +359,7 @@ def test_cases_file_sets_method_rtol_and_t_end_per_row(tmp_path, capsys):
     path.write_text("g0,theta0_deg,n,method,rtol,t_end\n60,30,4,radau5,1e-8,0.3\n"
                     "150,60,4,,,\n")
     out = tmp_path / "per_row"
-    assert main(["sweep", "--cases", str(path), "--t-end", "0.5", "--quiet",
+    assert main(["sweep", "--n", "6", "--cases", str(path), "--t-end", "0.5", "--quiet",
                  "--out", str(out)]) == 0
     frame = loopsim.read_results(str(out))
     first, second = frame.iloc[0], frame.iloc[1]
@@ -370,7 +370,7 @@ def test_cases_file_sets_method_rtol_and_t_end_per_row(tmp_path, capsys):
                               steady_tol=1e-6)
     np.testing.assert_array_equal(single.x_final.ravel(), first["x_final"])
     path.write_text("g0,theta0_deg,method\n60,30,euler\n")
-    assert main(["sweep", "--cases", str(path), "--out", str(tmp_path / "bad")]) == 2
+    assert main(["sweep", "--n", "6", "--cases", str(path), "--out", str(tmp_path / "bad")]) == 2
     err = capsys.readouterr().err
     assert "row 0, column method" in err and "euler" in err
 

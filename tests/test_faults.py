@@ -246,7 +246,7 @@ def test_damaged_initial_results_are_refused(tmp_path, capsys):
                  "--out", run]) == 0
     capsys.readouterr()
     _silent_flip(run, "x")
-    assert main(["run", "--initial", run, "--t-end", "0.01"]) == 2
+    assert main(["run", "--n", "6", "--initial", run, "--t-end", "0.01"]) == 2
     err = capsys.readouterr().err
     assert len(err.splitlines()) == 1 and "damaged" in err and run in err, err
 
@@ -254,9 +254,9 @@ def test_damaged_initial_results_are_refused(tmp_path, capsys):
 def test_damaged_chunk_as_initial_is_refused(sweep, capsys):
     path = os.path.join(sweep, io.CHUNK_PATTERN.format(1, 2))
     _silent_flip(path, "x_final")
-    assert main(["run", "--initial", path, "--t-end", "0.01"]) == 2
+    assert main(["run", "--n", "6", "--initial", path, "--t-end", "0.01"]) == 2
     assert "damaged" in capsys.readouterr().err
-    assert main(["run", "--initial", sweep, "--case-id", "0", "--t-end", "0.01"]) == 2
+    assert main(["run", "--n", "6", "--initial", sweep, "--case-id", "0", "--t-end", "0.01"]) == 2
     assert "damaged" in capsys.readouterr().err
 
 
@@ -271,28 +271,28 @@ def _point_file(path, rows):
     (["run", "--g0", "60", "--theta0", "30", "--n", "500"], ["--n", "at most 128", "500"]),
     (["run", "--g0", "60", "--theta0", "30", "--n", "auto", "--n-max", "100000"],
      ["--n-max", "100000"]),
-    (["run", "--g0", "60", "--theta0", "30", "--snapshots", "10000000"],
+    (["run", "--n", "6", "--g0", "60", "--theta0", "30", "--snapshots", "10000000"],
      ["--snapshots", "10000000"]),
-    (["run", "--g0", "60", "--theta0", "30", "--out", ""], ["--out is empty"]),
-    (["run", "--g0", "60", "--initial", "/dev/zero"], ["/dev/zero", "not a regular file"]),
-    (["sweep", "--g0", "1:2:1000000000", "--theta0", "30", "--out", "{tmp}/s"],
+    (["run", "--n", "6", "--g0", "60", "--theta0", "30", "--out", ""], ["--out is empty"]),
+    (["run", "--n", "6", "--g0", "60", "--initial", "/dev/zero"], ["/dev/zero", "not a regular file"]),
+    (["sweep", "--n", "6", "--g0", "1:2:1000000000", "--theta0", "30", "--out", "{tmp}/s"],
      ["--g0", "1000000000"]),
-    (["sweep", "--g0", "1:2:1000", "--theta0", "1:80:1001", "--out", "{tmp}/s"],
+    (["sweep", "--n", "6", "--g0", "1:2:1000", "--theta0", "1:80:1001", "--out", "{tmp}/s"],
      ["1001000 cases"]),
     (["sweep", "--g0", "10", "--theta0", "30", "--n", "200", "--out", "{tmp}/s"],
      ["n must be at most 128"]),
-    (["sweep", "--g0", "10", "--theta0", "30", "--snapshots-for", "0", "--snapshots",
+    (["sweep", "--n", "6", "--g0", "10", "--theta0", "30", "--snapshots-for", "0", "--snapshots",
       "100000", "--out", "{tmp}/s"], ["100000"]),
-    (["sweep", "--cases", "/dev/zero", "--out", "{tmp}/s"], ["not a regular file"]),
-    (["sweep", "--g0", "10", "--theta0", "30", "--out", ""], ["--out is empty"]),
+    (["sweep", "--n", "6", "--cases", "/dev/zero", "--out", "{tmp}/s"], ["not a regular file"]),
+    (["sweep", "--n", "6", "--g0", "10", "--theta0", "30", "--out", ""], ["--out is empty"]),
     (["stability", "--paper", "--n-max", "100000"], ["--n-max", "100000"]),
     (["stability", "--n", "100000"], ["--n", "100000"]),
     (["branch", "--n", "129"], ["--n", "at most 48", "129"]),
-    (["sweep", "--g0", "10", "--theta0", "30", "--dask", "--workers", "1000", "--out",
+    (["sweep", "--n", "6", "--g0", "10", "--theta0", "30", "--dask", "--workers", "1000", "--out",
       "{tmp}/s"], ["--workers", "1000"]),
-    (["sweep", "--g0", "10", "--theta0", "30", "--scheduler", "notanaddress", "--out",
+    (["sweep", "--n", "6", "--g0", "10", "--theta0", "30", "--scheduler", "notanaddress", "--out",
       "{tmp}/s"], ["--scheduler", "notanaddress"]),
-    (["sweep", "--g0", "10", "--theta0", "30", "--scheduler", "", "--out", "{tmp}/s"],
+    (["sweep", "--n", "6", "--g0", "10", "--theta0", "30", "--scheduler", "", "--out", "{tmp}/s"],
      ["--scheduler", "''"]),
     (["figures", "{tmp}/s", "--out", "{tmp}/figs", "--branch-n", "500"], ["branch_n", "500"]),
     (["figures", "{tmp}/s", "--out", "{tmp}/figs", "--branch-n", "2"], ["branch_n", "2"]),
@@ -300,9 +300,9 @@ def _point_file(path, rows):
     (["figures", "{tmp}/s", "--out", "{tmp}/figs", "--only", "bogus"], ["bogus"]),
     (["figures", "{tmp}/s", "--out", "{tmp}/figs", "--gallery-theta0", "200"],
      ["gallery_theta0", "200"]),
-    (["run", "--g0", "60", "--theta0", "30", "--n-max", "40"], ["--n-max applies only"]),
-    (["run", "--g0", "60", "--theta0", "30", "--tail-tol", "1e-4"], ["--tail-tol applies"]),
-    (["sweep", "--g0", "10", "--theta0", "30", "--tail-tol", "1e-4", "--out", "{tmp}/s"],
+    (["run", "--n", "6", "--g0", "60", "--theta0", "30", "--n-max", "40"], ["--n-max applies only"]),
+    (["run", "--n", "6", "--g0", "60", "--theta0", "30", "--tail-tol", "1e-4"], ["--tail-tol applies"]),
+    (["sweep", "--n", "6", "--g0", "10", "--theta0", "30", "--tail-tol", "1e-4", "--out", "{tmp}/s"],
      ["--tail-tol applies only"]),
     (["sweep", "--g0", "10", "--theta0", "30", "--n", "auto", "--n-max", "4", "--out",
       "{tmp}/s"], ["--n-max 4 is below", "6"]),
@@ -323,7 +323,7 @@ def test_sizes_refused_in_one_line_before_work(tmp_path, capsys, argv, words):
 def test_cases_file_columns_checked(tmp_path, capsys, header, rows, words):
     path = tmp_path / "cases.csv"
     path.write_text(header + "\n" + "\n".join(rows) + "\n")
-    assert main(["sweep", "--cases", str(path), "--out", str(tmp_path / "s")]) == 2
+    assert main(["sweep", "--n", "6", "--cases", str(path), "--out", str(tmp_path / "s")]) == 2
     err = capsys.readouterr().err
     assert len(err.splitlines()) == 1 and all(w in err for w in words), err
     assert not (tmp_path / "s").exists()
@@ -357,7 +357,7 @@ def test_cases_file_slenderness_of_a_local_row_is_refused(tmp_path, capsys):
     path = tmp_path / "cases.csv"
     path.write_text("g0,theta0_deg,model,slenderness\n10,30,nonlocal,1e-3\n"
                     "10,30,local,1e-3\n")
-    assert main(["sweep", "--cases", str(path), "--out", str(tmp_path / "s")]) == 2
+    assert main(["sweep", "--n", "6", "--cases", str(path), "--out", str(tmp_path / "s")]) == 2
     err = capsys.readouterr().err
     assert len(err.splitlines()) == 1 and "case 1" in err and "'local'" in err, err
     assert not (tmp_path / "s").exists()
@@ -372,7 +372,7 @@ def test_point_files_bounded_by_size_rows_and_kind(tmp_path, capsys):
     rows = _point_file(tmp_path / "rows.csv", validation.MAX_POINTS + 1)
     for path, word in ((fifo, "not a regular file"), (big, "MiB"),
                        (rows, f"more than {validation.MAX_POINTS} points")):
-        assert main(["run", "--g0", "60", "--initial", path]) == 2
+        assert main(["run", "--n", "6", "--g0", "60", "--initial", path]) == 2
         err = capsys.readouterr().err
         assert len(err.splitlines()) == 1 and word in err and path in err, err
 
@@ -381,7 +381,7 @@ def test_cases_file_rows_bounded(tmp_path, capsys, monkeypatch):
     monkeypatch.setattr(validation, "MAX_CASES", 3)
     path = tmp_path / "cases.csv"
     path.write_text("g0,theta0_deg\n" + "10,30\n" * 4)
-    assert main(["sweep", "--cases", str(path), "--out", str(tmp_path / "s")]) == 2
+    assert main(["sweep", "--n", "6", "--cases", str(path), "--out", str(tmp_path / "s")]) == 2
     err = capsys.readouterr().err
     assert "more than 3 rows" in err and not (tmp_path / "s").exists()
 
@@ -440,8 +440,8 @@ def test_run_stops_on_a_signal_in_one_line(tmp_path, signum, status):
 
 
 @pytest.mark.skipif(not sys.platform.startswith("linux"), reason="reads /proc")
-@pytest.mark.parametrize("command", [["run", "--g0", "60", "--theta0", "30"],
-                                     ["sweep", "--g0", "10,60", "--theta0", "30"]])
+@pytest.mark.parametrize("command", [["run", "--n", "6", "--g0", "60", "--theta0", "30"],
+                                     ["sweep", "--n", "6", "--g0", "10,60", "--theta0", "30"]])
 @pytest.mark.parametrize("delay", [0.0, 0.3, 0.8])
 def test_a_signal_while_loading_is_one_line_and_exit_130(tmp_path, command, delay):
     """Ctrl-C in the first second (NumPy, Numba and pandas still loading): one line, exit
@@ -566,7 +566,7 @@ def test_output_that_takes_no_files_is_refused_before_work(tmp_path, capsys, mon
 
     monkeypatch.setattr(api, "simulate", no_work)
     if os.path.isdir("/proc"):
-        assert main(["run", "--g0", "60", "--theta0", "30", "--out", "/proc/x.parquet"]) == 2
+        assert main(["run", "--n", "6", "--g0", "60", "--theta0", "30", "--out", "/proc/x.parquet"]) == 2
         err = capsys.readouterr().err
         assert len(err.splitlines()) == 1 and "/proc" in err and "takes no files" in err, err
 
@@ -577,8 +577,8 @@ def test_output_that_takes_no_files_is_refused_before_work(tmp_path, capsys, mon
         raise OSError(errno.EROFS, "Read-only file system")
 
     monkeypatch.setattr(tempfile, "mkstemp", read_only)
-    for argv in (["run", "--g0", "60", "--theta0", "30", "--out", str(tmp_path / "r.parquet")],
-                 ["sweep", "--g0", "60", "--theta0", "30", "--out", str(tmp_path / "s")]):
+    for argv in (["run", "--n", "6", "--g0", "60", "--theta0", "30", "--out", str(tmp_path / "r.parquet")],
+                 ["sweep", "--n", "6", "--g0", "60", "--theta0", "30", "--out", str(tmp_path / "s")]):
         assert main(argv) == 3
         err = capsys.readouterr().err
         assert len(err.splitlines()) == 1 and "Read-only file system" in err, err
@@ -588,15 +588,15 @@ def test_output_that_takes_no_files_is_refused_before_work(tmp_path, capsys, mon
 def test_perturbation_larger_than_the_loop_is_refused(tmp_path, capsys):
     from loopsim.cli import main
 
-    assert main(["run", "--g0", "60", "--theta0", "30", "--perturbation", "2"]) == 2
+    assert main(["run", "--n", "6", "--g0", "60", "--theta0", "30", "--perturbation", "2"]) == 2
     err = capsys.readouterr().err
     assert "perturbation must be at most 0.5" in err and len(err.strip().splitlines()) == 1
     out = tmp_path / "s"
-    assert main(["sweep", "--g0", "60", "--theta0", "30", "--perturbation", "0.9",
+    assert main(["sweep", "--n", "6", "--g0", "60", "--theta0", "30", "--perturbation", "0.9",
                  "--out", str(out)]) == 2
     assert "perturbation" in capsys.readouterr().err
     with pytest.raises(ValueError, match="perturbation"):
-        loopsim.simulate(60.0, 30.0, perturbation=1.0)
+        loopsim.simulate(60.0, 30.0, n=6, perturbation=1.0)
 
 
 @pytest.mark.slow
@@ -640,7 +640,7 @@ def test_ctrl_c_with_dask_is_one_line_and_leaves_no_process(tmp_path):
 
     out = tmp_path / "s"
     process = subprocess.Popen(
-        [sys.executable, "-m", "loopsim", "sweep", "--g0", "100:250:8", "--theta0", "30,60",
+        [sys.executable, "-m", "loopsim", "sweep", "--n", "6", "--g0", "100:250:8", "--theta0", "30,60",
          "--chunk-size", "1", "--dask", "--workers", "2", "--out", str(out)],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     deadline = time.monotonic() + 300  # the workers may compile first

@@ -62,7 +62,7 @@ FAST = [
 def test_hard_case(method, label, g0, theta0, kwargs, status, regime, length_bound):
     """Each hard case ends with its expected status and regime and keeps its length
     within its bound; a failure mode changing (say, "no penalty" failing) fails here."""
-    result = api.simulate(g0, theta0, method=method, twin=False, **kwargs)
+    result = api.simulate(g0, theta0, method=method, twin=False, **{"n": 6, **kwargs})
     summary = check(result, benign=False)
     assert summary["status"] == status and result.regime == regime
     assert abs(summary["length_error"]) < length_bound
@@ -109,7 +109,7 @@ def test_hard_case_long(method, label, g0, theta0, kwargs, benign, status, regim
                         tilt, length_bound):
     """Each long case ends with its expected status, regime and determinacy, its terminal
     tilt in its range and its length error within its bound."""
-    result = api.simulate(g0, theta0, method=method, **kwargs)
+    result = api.simulate(g0, theta0, method=method, **{"n": 6, **kwargs})
     summary = check(result, benign)
     assert summary["status"] == status and result.regime == regime
     if determined is not None:

@@ -55,8 +55,8 @@ def test_circle_file_runs_like_the_builtin_circle(tmp_path, rng):
     s = uneven(120, rng)
     points = 0.7 * np.stack([np.sin(s), np.cos(0.5) * np.cos(s), np.sin(0.5) * np.cos(s)], axis=1)
     path = write_points(tmp_path / "c.csv", points)
-    from_file = api.simulate(60, None, initial=path, t_span=(0, 0.2))
-    builtin = api.simulate(60, np.degrees(0.5), perturbation=0.0, t_span=(0, 0.2))
+    from_file = api.simulate(60, None, initial=path, n=6, t_span=(0, 0.2))
+    builtin = api.simulate(60, np.degrees(0.5), n=6, perturbation=0.0, t_span=(0, 0.2))
     assert from_file.inputs["perturbation"] == 0.0  # no perturbation unless asked
     assert from_file.inputs["theta0_deg"] == pytest.approx(np.degrees(0.5), abs=1e-10)
     assert np.max(np.abs(from_file.x_final - builtin.x_final)) < 1e-9
@@ -115,12 +115,12 @@ def test_continuation_equals_one_longer_run(tmp_path, capsys):
     x, info = shapes.load_initial(path)
     assert np.array_equal(x, first.x_final)  # exact: stored coefficients, no resampling
     assert info["kind"] == "run" and info["g0"] == 60 and info["t_final"] == 1.0
-    more = api.simulate(60, None, initial=path, t_span=(0, 0.5), **TIGHT)
+    more = api.simulate(60, None, initial=path, n=6, t_span=(0, 0.5), **TIGHT)
     whole = api.simulate(60, 30, n=6, t_span=(0, 1.5), **TIGHT)
     difference = np.max(np.abs(more.x_final - whole.x_final))
     assert difference < 1e-8, difference  # measured ~1e-11
-    # the CLI: g0 and n from the file
-    assert main(["run", "--initial", path, "--t-end", "0.5", "--json", "--rtol", "1e-10",
+    # the CLI: g0 from the file
+    assert main(["run", "--n", "6", "--initial", path, "--t-end", "0.5", "--json", "--rtol", "1e-10",
                  "--atol", "1e-13"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["g0"] == 60 and out["n"] == 6 and out["initial"]["kind"] == "run"
@@ -142,7 +142,7 @@ def test_sweep_results_and_cases_with_initial_column(tmp_path, capsys):
     assert info["kind"] == "sweep" and info["g0"] == 80 and info["n"] == 4
     with pytest.raises(ValueError, match="choose one"):
         shapes.load_initial(out)
-    code = main(["run", "--initial", out, "--case-id", "1", "--t-end", "0.1", "--json"])
+    code = main(["run", "--n", "6", "--initial", out, "--case-id", "1", "--t-end", "0.1", "--json"])
     assert code == 0 and json.loads(capsys.readouterr().out)["g0"] == 80
     # a cases file with a per-row initial column (paths relative to the cases file)
     cases = tmp_path / "cases.csv"
@@ -151,7 +151,7 @@ def test_sweep_results_and_cases_with_initial_column(tmp_path, capsys):
                      f"50,,4,sweep,1\n"
                      f"70,,8,{os.path.abspath(EXAMPLE)},\n")
     out2 = str(tmp_path / "sweep2")
-    assert main(["sweep", "--cases", str(cases), "--t-end", "0.05", "--out", out2, "--quiet",
+    assert main(["sweep", "--n", "6", "--cases", str(cases), "--t-end", "0.05", "--out", out2, "--quiet",
                  "--snapshots-for", "1"]) == 0
     rows = loopsim.read_results(out2)
     _, example = shapes.load_initial(EXAMPLE, 8)
@@ -167,7 +167,7 @@ def test_sweep_results_and_cases_with_initial_column(tmp_path, capsys):
 
 def test_api_initial_arguments():
     circle = shapes.inclined_circle(5, 0.3)
-    result = api.simulate(10, None, initial=circle, t_span=(0, 0.01))
+    result = api.simulate(10, None, initial=circle, n=5, t_span=(0, 0.01))
     assert result.inputs["n"] == 5 and result.initial_info["kind"] == "coefficients"
     with pytest.raises(ValueError, match="theta0_deg must be None"):
         api.simulate(10, 30, initial=circle)
@@ -217,7 +217,7 @@ def test_bad_point_files(which, tmp_path, capsys):
     path, word = _bad_files(tmp_path)[which]
     with pytest.raises(ValueError, match=word):
         shapes.load_initial(path, 6)
-    assert main(["run", "--initial", path, "--g0", "10", "--t-end", "0.01"]) == 2
+    assert main(["run", "--n", "6", "--initial", path, "--g0", "10", "--t-end", "0.01"]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and err.startswith("loopsim: error:") and word in err
 
@@ -238,6 +238,54 @@ def test_bad_case_ids_and_flag_combinations(tmp_path, capsys):
         (["--initial", points], "--g0 is required"),
         (["--g0", "1", "--theta0", "30", "--case-id", "0"], "--case-id needs --initial"),
     ]:
-        assert main(["run", *argv, "--t-end", "0.01"]) == 2, argv
+        assert main(["run", "--n", "6", *argv, "--t-end", "0.01"]) == 2, argv
         err = capsys.readouterr().err.strip()
         assert len(err.splitlines()) == 1 and err.startswith("loopsim: error:") and word in err
+
+
+def test_n_auto_starts_a_point_file_at_the_order_its_content_needs(tmp_path, capsys):
+    """``--initial POINTS --n auto``: a perturbed tilted circle sampled at 256 equally
+    spaced parameter values (not arc length: refitted by arc length, its content above
+    order 6 is about 5e-5 of its RMS amplitude) starts at the lowest order whose
+    truncation leaves out at most config.INITIAL_CONTENT_TOL, not at order 6, and every
+    order of the ladder starts from that same shape (exactly zero-padded)."""
+    from loopsim import config
+
+    x = shapes.initial_shape(6, np.radians(45.0), 1e-3, 3)
+    s = np.linspace(0.0, 2.0 * np.pi, 256, endpoint=False)
+    path = write_points(tmp_path / "tilted.csv", spectral.evaluate(x, s).T)
+    assert shapes.load_initial(path, 6)[1]["truncation"] > 1e-6  # content above order 6
+    order = shapes.auto_start_order(path)
+    start, info = shapes.load_initial(path, order)
+    assert order > 6 and info["truncation"] <= config.INITIAL_CONTENT_TOL
+    assert shapes.load_initial(path, order - 1)[1]["truncation"] > config.INITIAL_CONTENT_TOL
+    assert shapes.auto_start_order(path, high=8) == 8  # never above the ladder's top
+    result = api.simulate(60.0, None, initial=path, t_span=(0.0, 0.05), twin=False)
+    assert result.inputs["n"] == order == result.initial_info["n"]
+    assert result.n_used >= order
+    np.testing.assert_array_equal(result.x[0], spectral.resize(start, result.n_used))
+    assert main(["run", "--initial", path, "--g0", "60", "--t-end", "0.05", "--no-twin",
+                 "--json"]) == 0
+    printed = json.loads(capsys.readouterr().out)
+    assert printed["n"] == order and printed["initial"]["n"] == order
+    # a fixed n is what it says: the file fitted at that order
+    assert api.simulate(60.0, None, initial=path, n=6, t_span=(0.0, 0.01),
+                        twin=False).inputs["n"] == 6
+
+
+def test_a_cases_file_point_row_with_n_auto_starts_at_its_content_order(tmp_path, capsys):
+    """The sweep's counterpart of ``run --initial POINTS --n auto``: a cases-file row
+    that starts from a point file and gives no n starts at the order its content needs;
+    a row that gives n keeps it."""
+    x = shapes.initial_shape(6, np.radians(45.0), 1e-3, 3)
+    s = np.linspace(0.0, 2.0 * np.pi, 256, endpoint=False)
+    write_points(tmp_path / "tilted.csv", spectral.evaluate(x, s).T)
+    order = shapes.auto_start_order(str(tmp_path / "tilted.csv"))
+    cases = tmp_path / "cases.csv"
+    cases.write_text("g0,initial\n60,tilted.csv\n")
+    out = str(tmp_path / "s")
+    assert main(["sweep", "--cases", str(cases), "--n", "auto", "--t-end", "0.01", "--no-twin",
+                 "--quiet", "--out", out]) == 0
+    assert order > 6 and loopsim.read_results(out)["n"].tolist() == [order]
+    fixed = sweeps.read_cases_file(str(cases), n=8)  # no --n auto: the given order
+    assert fixed[0]["n"] == 8

@@ -76,7 +76,7 @@ def test_cases_file_mixes_models_per_row(tmp_path):
     path.write_text("g0,theta0_deg,n,model,slenderness\n40,60,6,nonlocal,1e-2\n"
                     "40,60,6,local,\n40,60,6,nonlocal,\n")
     out = tmp_path / "mixed"
-    assert main(["sweep", "--cases", str(path), "--t-end", "0.3", "--no-twin", "--quiet",
+    assert main(["sweep", "--n", "6", "--cases", str(path), "--t-end", "0.3", "--no-twin", "--quiet",
                  "--slenderness", "1e-3", "--out", str(out)]) == 0
     frame = loopsim.read_results(str(out))
     assert list(frame["model"]) == ["nonlocal", "local", "nonlocal"]
@@ -110,7 +110,7 @@ def test_n_auto_stops_at_the_models_highest_order():
 ])
 def test_bad_model_options_are_one_line_errors(argv, words, capsys, tmp_path):
     """run and sweep refuse them with exit 2, one line naming the value, nothing written."""
-    for command in (["run"], ["sweep", "--out", str(tmp_path / "s")]):
+    for command in (["run", "--n", "6"], ["sweep", "--n", "6", "--out", str(tmp_path / "s")]):
         try:
             status = main(command + ["--g0", "20", "--theta0", "30"] + argv)
         except SystemExit as exc:  # argparse's own errors (a bad number, a bad choice)

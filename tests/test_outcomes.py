@@ -71,7 +71,7 @@ def test_determinacy_rule():
     nothing = outcomes.determinacy(failed, run, 7)  # a failed run: no outcome to determine
     assert nothing["determined"] is False and nothing["twin_nfev"] == 7
     assert np.isnan(nothing["theta_uncertainty_deg"])
-    result = loopsim.simulate(60.0, 30.0, t_span=(0, 1.0), max_steps=20)
+    result = loopsim.simulate(60.0, 30.0, n=6, t_span=(0, 1.0), max_steps=20)
     assert not result.success and result.determined is False  # and no twin was run:
     assert result.summary()["twin_nfev"] == 0
     assert outcomes.twin_tolerances(1e-6, 1e-9, 1e-5) == pytest.approx((1e-7, 1e-10, 1e-6), rel=1e-15)
@@ -98,7 +98,7 @@ def test_the_same_outcome_fields_in_run_json_simulate_and_sweep_rows(tmp_path, c
 def test_without_a_twin_determined_is_empty(tmp_path):
     result = loopsim.simulate(30.0, 45.0, n=6, t_span=(0.0, 0.5), twin=False)
     assert result.determined is None and result.summary()["twin_nfev"] == 0
-    assert main(["sweep", "--g0", "30", "--theta0", "45", "--t-end", "0.5", "--no-twin",
+    assert main(["sweep", "--n", "6", "--g0", "30", "--theta0", "45", "--t-end", "0.5", "--no-twin",
                  "--quiet", "--out", str(tmp_path / "s")]) == 0
     frame = loopsim.read_results(str(tmp_path / "s"))
     assert frame["determined"].isna().all() and frame["theta_uncertainty_deg"].isna().all()
@@ -113,10 +113,10 @@ def test_every_written_column_has_a_unit_and_a_description(tmp_path):
     from loopsim import columns
 
     out = tmp_path / "s"
-    assert main(["sweep", "--g0", "30", "--theta0", "45", "--t-end", "0.5", "--quiet",
+    assert main(["sweep", "--n", "6", "--g0", "30", "--theta0", "45", "--t-end", "0.5", "--quiet",
                  "--snapshots-for", "0", "--snapshots", "3", "--out", str(out)]) == 0
     run = tmp_path / "run.parquet"
-    assert main(["run", "--g0", "30", "--theta0", "45", "--t-end", "0.5", "--out",
+    assert main(["run", "--n", "6", "--g0", "30", "--theta0", "45", "--t-end", "0.5", "--out",
                  str(run)]) == 0
     files = list(out.glob("chunk-*.parquet")) + list((out / "_snapshots").glob("*.parquet"))
     assert len(files) == 2
@@ -137,17 +137,19 @@ def test_every_written_column_has_a_unit_and_a_description(tmp_path):
 def test_python_sweep_writes_the_directory_the_command_line_writes(tmp_path):
     """loopsim.sweep(...) mirrors `loopsim sweep`: the same rows, bit for bit, and either
     resumes the other's directory; bad options are one-line errors."""
-    frame = loopsim.sweep([10.0, 40.0], 30.0, tmp_path / "py", t_end=0.5, twin=False)
-    assert main(["sweep", "--g0", "10,40", "--theta0", "30", "--t-end", "0.5", "--no-twin",
+    frame = loopsim.sweep([10.0, 40.0], 30.0, tmp_path / "py", n=6, t_end=0.5, twin=False)
+    assert main(["sweep", "--n", "6", "--g0", "10,40", "--theta0", "30", "--t-end", "0.5", "--no-twin",
                  "--quiet", "--out", str(tmp_path / "cli")]) == 0
     cli = loopsim.read_results(str(tmp_path / "cli"))
     keep = [c for c in frame.columns if c != "wall_s"]
     assert len(frame) == 2 and list(frame["case_id"]) == [0, 1]
     assert frame[keep].equals(cli[keep])
-    again = loopsim.sweep([10.0, 40.0], 30.0, tmp_path / "cli", t_end=0.5, twin=False)
+    again = loopsim.sweep([10.0, 40.0], 30.0, tmp_path / "cli", n=6, t_end=0.5, twin=False)
     assert again[keep].equals(cli[keep])  # resumed: nothing to do, the same table
-    with pytest.raises(ValueError, match="colour"):
+    with pytest.raises(TypeError, match="colour"):  # an unknown keyword, as in any call
         loopsim.sweep(10.0, 30.0, tmp_path / "bad", colour="red")
+    with pytest.raises(TypeError, match="cases"):
+        loopsim.sweep(10.0, 30.0, tmp_path / "bad", cases=[])
     with pytest.raises(ValueError, match="n must be"):
         loopsim.sweep(10.0, 30.0, tmp_path / "bad", n="automatic")
 

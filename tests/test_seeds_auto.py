@@ -4,10 +4,12 @@ import dataclasses
 
 import numpy as np
 import pandas as pd
+import pyarrow as pa
+import pyarrow.parquet as pq
 import pytest
 
 import loopsim
-from loopsim import io, seeding, summary, sweeps
+from loopsim import columns, io, seeding, summary, sweeps
 from loopsim.io import STOPS_FILE, read_seeds_auto
 from loopsim.sweeps.seeds_auto import run_seeds_auto
 
@@ -94,6 +96,9 @@ def test_the_python_sweep_runs_seeds_auto_and_refuses_targets_without_it(tmp_pat
     assert len(rows) == 4 and rows["round"].tolist() == [0] * 4
     stops = io.read_stop_table(str(out))
     assert stops["stop_reason"].tolist() == [seeding.DETERMINISTIC]
+    schema = pq.read_schema(out / io.STOPS_FILE)
+    assert schema.field("n").type == pa.int64() and stops["n"].tolist() == [4]
+    assert all(f.metadata[b"unit"] == columns.STOP_COLUMNS[f.name][0].encode() for f in schema)
     with pytest.raises(ValueError, match="seeds='auto'"):
         loopsim.sweep([10.0], [30.0], tmp_path / "fixed", n=4, max_seeds=8, **FAST)
     with pytest.raises(ValueError, match="seeds must be"):
@@ -140,7 +145,7 @@ def test_seeds_auto_from_the_command_line(tmp_path, capsys):
                          (["--seeds", "many"], "--seeds must be a count"),
                          (["--seeds", "auto", "--shard", "0/2"], "--shard does not apply"),
                          (["--seeds", "auto", "--max-seeds", "2"], "--min-seeds and --max")):
-        base = ["sweep", "--g0", "10", "--theta0", "30", "--out", str(tmp_path / "bad")]
+        base = ["sweep", "--n", "6", "--g0", "10", "--theta0", "30", "--out", str(tmp_path / "bad")]
         assert main(base + bad) == 2
         assert message in capsys.readouterr().err
     assert not (tmp_path / "bad").exists()

@@ -1,11 +1,14 @@
 """Outcomes as distributions (loopsim.summary): the Wilson interval and the bootstrap
 against closed forms and known cases, cells and their counts, the command."""
+import json
+
 import numpy as np
 import pandas as pd
+import pyarrow.parquet as pq
 import pytest
 
 import loopsim
-from loopsim import summary
+from loopsim import columns, summary
 from loopsim.cli import main
 
 
@@ -63,7 +66,7 @@ def test_summarize_groups_seeds_into_cells():
 
 def test_summary_command_on_a_sweep_with_seeds(tmp_path, capsys):
     out = tmp_path / "s"
-    assert main(["sweep", "--g0", "10,40", "--theta0", "30", "--seeds", "3", "--t-end", "0.5",
+    assert main(["sweep", "--n", "6", "--g0", "10,40", "--theta0", "30", "--seeds", "3", "--t-end", "0.5",
                  "--no-twin", "--quiet", "--out", str(out)]) == 0
     capsys.readouterr()
     path = tmp_path / "cells" / "summary.parquet"
@@ -74,6 +77,10 @@ def test_summary_command_on_a_sweep_with_seeds(tmp_path, capsys):
     assert list(table["g0"]) == [10.0, 40.0] and list(table["seeds"]) == [3, 3]
     again = loopsim.summarize(loopsim.read_results(str(out)))
     pd.testing.assert_frame_equal(table, again)
+    schema = pq.read_schema(path)
+    for field in schema:  # every column declared in loopsim.columns, with its unit
+        assert field.metadata[b"unit"] == columns.SUMMARY_COLUMNS[field.name][0].encode()
+    assert schema.metadata[b"summary_of"] == b"s"  # the directory's name, not its path
 
 
 def _seeds_table(tilts, regimes=None, g0=150.0):
@@ -106,7 +113,7 @@ def test_compare_verdicts_on_one_distribution_and_on_shifted_ones():
 def test_compare_command_on_two_sweeps(tmp_path, capsys):
     """rtol 1e-6 against 1e-7 on stable cells: the same distributions."""
     for name, rtol in (("a", "1e-6"), ("b", "1e-7")):
-        assert main(["sweep", "--g0", "10,40", "--theta0", "30", "--seeds", "4", "--t-end",
+        assert main(["sweep", "--n", "6", "--g0", "10,40", "--theta0", "30", "--seeds", "4", "--t-end",
                      "0.5", "--rtol", rtol, "--no-twin", "--quiet", "--out",
                      str(tmp_path / name)]) == 0
     capsys.readouterr()
@@ -115,6 +122,10 @@ def test_compare_command_on_two_sweeps(tmp_path, capsys):
     printed = capsys.readouterr().out
     assert "2 cell(s) indistinguishable at this sample size" in printed
     assert len(pd.read_parquet(tmp_path / "c.parquet")) == 2
+    schema = pq.read_schema(tmp_path / "c.parquet")
+    assert {f.name: f.metadata[b"description"].decode() for f in schema} == {
+        name: columns.COMPARE_COLUMNS[name][1] for name in schema.names}
+    assert json.loads(schema.metadata[b"compared"]) == ["a", "b"]
     assert main(["compare", str(tmp_path / "a"), str(tmp_path / "b"), "--alpha", "0"]) == 2
 
 
@@ -224,7 +235,7 @@ def test_summary_figure_of_cells_sharing_a_point_is_refused_before_writing(tmp_p
     cases = tmp_path / "cases.csv"
     cases.write_text("g0,theta0_deg,n,seed,rtol\n10,30,4,0,1e-6\n10,30,4,0,1e-7\n")
     out = tmp_path / "s"
-    assert main(["sweep", "--cases", str(cases), "--t-end", "0.2", "--no-twin", "--quiet",
+    assert main(["sweep", "--n", "6", "--cases", str(cases), "--t-end", "0.2", "--no-twin", "--quiet",
                  "--threads", "1", "--out", str(out)]) == 0
     capsys.readouterr()
     table, figure = tmp_path / "cells.parquet", tmp_path / "cells.png"

@@ -106,9 +106,9 @@ def test_old_layout_is_refused_in_one_line(tmp_path, capsys):
     out.mkdir()
     (out / "sweep.json").write_text("{}")
     (out / "chunk-00000.parquet").write_bytes(b"PAR1")
-    with pytest.raises(ValueError, match="loopsim <= 0.2.0.*new --out"):
+    with pytest.raises(ValueError, match=r"layout-1 .*loopsim 0\.2\.0 and earlier releases.*new --out"):
         loopsim.read_results(str(out))
-    assert main(["sweep", "--g0", "10", "--theta0", "30", "--out", str(out)]) == 2
+    assert main(["sweep", "--n", "6", "--g0", "10", "--theta0", "30", "--out", str(out)]) == 2
     err = capsys.readouterr().err
     assert len(err.splitlines()) == 1 and "new --out" in err
 
@@ -381,7 +381,7 @@ def test_worker_error_is_raised_after_finished_cases_are_written(tmp_path, refer
 ])
 def test_sweep_backend_options_checked_before_work(tmp_path, capsys, argv, word):
     out = tmp_path / "s"
-    assert main(["sweep", "--g0", "10", "--theta0", "30", "--out", str(out), *argv]) == 2
+    assert main(["sweep", "--n", "6", "--g0", "10", "--theta0", "30", "--out", str(out), *argv]) == 2
     err = capsys.readouterr().err
     assert len(err.splitlines()) == 1 and word in err, err
     assert not (out / "_sweep.json").exists()

@@ -1,8 +1,10 @@
-"""Command-line interface: ``loopsim run``, ``loopsim sweep`` and ``loopsim stability``.
+"""Command-line interface: ``loopsim run``, ``loopsim sweep``, ``loopsim summary`` ...
 
 Errors in the input end with one line ``loopsim: error: ...`` on stderr and
 exit status 2; a run that fails numerically exits 1 after printing its summary; the
-machine refusing to go on (disk full, read-only filesystem, I/O error) exits 3.
+machine refusing to go on (disk full, read-only filesystem, I/O error) exits 3
+(``common.EXIT_CODES``; docs/cli.md is generated from these parsers by
+scripts/cli_reference.py).
 
 One module per command (``run``, ``sweep``, ``stability``, ``summary``, ``compare``,
 ``branch``, ``figures``, ``report``, ``animate``), each with its ``add_parser`` (its
@@ -12,14 +14,15 @@ nothing heavy until a command runs: ``loopsim --help`` imports neither NumPy nor
 import argparse
 import contextlib
 import sys
+import textwrap
 import warnings
 
 from .._version import __version__
 from ..config import ENVIRONMENT_ERRNOS
 from . import animate, branch, compare, figures, report, run, stability, summary, sweep
-from .common import EXIT_ENVIRONMENT, EXIT_FAILED_RUN, EXIT_USAGE, METHODS, Parser
+from .common import EXIT_ENVIRONMENT, EXIT_EPILOG, EXIT_FAILED_RUN, EXIT_USAGE, METHODS, Parser
 
-__all__ = ["EXIT_ENVIRONMENT", "EXIT_FAILED_RUN", "EXIT_USAGE", "METHODS", "main"]
+__all__ = ["EXIT_ENVIRONMENT", "EXIT_FAILED_RUN", "EXIT_USAGE", "METHODS", "build_parser", "main"]
 
 #: The commands, in the order ``loopsim --help`` lists them.
 COMMANDS = {"run": run, "sweep": sweep, "stability": stability, "summary": summary,
@@ -27,22 +30,37 @@ COMMANDS = {"run": run, "sweep": sweep, "stability": stability, "summary": summa
             "animate": animate}
 
 
-def _build_parser():
+#: ``loopsim --help``'s examples: the README's main job first (tests/test_cli_reference.py).
+EXAMPLES = (
+    ("a resolved run (n auto, the default)", "loopsim run --g0 150 --theta0 45"),
+    ("the paper's scheme", "loopsim run --g0 150 --theta0 45 --n 6 --method rkf45"),
+    ("the README's main job", "loopsim sweep --g0 10:150:8 --theta0 10:90:9 --n auto "
+                              "--out runs/phase --figure runs/phase.png"),
+    ("the paper's n = 6 grid", "loopsim sweep --g0 10:150:8 --theta0 10:90:9 --n 6 --method "
+                               "rkf45 --out runs/phase_n6"),
+    ("the circle's stability", "loopsim stability --n 16"),
+)
+
+
+def build_parser():
+    """The ``loopsim`` parser: every command of :data:`COMMANDS` (and any other a command
+    module registers), each --help ending with the exit statuses (``common.EXIT_EPILOG``)."""
     parser = Parser(
         prog="loopsim",
-        description="Flexible elastic loops sedimenting in a viscous fluid "
-        "(local slender-body theory, spectral in arc length).",
-        epilog="Examples:\n  loopsim run --g0 60 --theta0 30\n"
-        "  loopsim run --g0 150 --theta0 60 --n 8 --json\n"
-        "  loopsim sweep --g0 10:350:8 --theta0 10:90:5 --out runs/phase --figure phase.png\n"
-        "  loopsim stability --n 16\n"
-        "  loopsim stability --paper --n-max 20",
+        description=textwrap.fill(
+            "Flexible elastic loops sedimenting in a viscous fluid (local or nonlocal "
+            "slender-body theory, spectral in arc length). Units: docs/model.md#units.", 88),
+        epilog="Examples:\n" + "\n".join(f"  {command}\n      ({what})"
+                                          for what, command in EXAMPLES)
+        + "\n\n" + textwrap.fill(EXIT_EPILOG, 88),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("--version", action="version", version=f"loopsim {__version__}")
     commands = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
     for module in COMMANDS.values():
         module.add_parser(commands)
+    for command in commands.choices.values():
+        command.epilog = command.epilog or EXIT_EPILOG
     return parser
 
 
@@ -57,7 +75,7 @@ def _one_line_warnings():
 
 
 def main(argv=None):
-    parser = _build_parser()
+    parser = build_parser()
     args = parser.parse_args(argv)
     try:
         with _one_line_warnings():

@@ -17,7 +17,8 @@ def add_parser(commands):
     )
     branch.add_argument("--n", type=int, default=12, help="Fourier truncation order (>= 4)")
     branch.add_argument("--q-max", type=real, default=25.0, metavar="Q",
-                        help="continue up to this q (> the in-plane threshold 8.9001)")
+                        help="continue up to this q = g0 sin(theta0)/3 (dimensionless; > the "
+                        "in-plane threshold 8.9001)")
     branch.add_argument("--json", action="store_true", help="print one JSON object")
     return branch
 

@@ -19,6 +19,23 @@ METHODS = ("radau5", "rkf45")
 EXIT_FAILED_RUN = 1
 EXIT_USAGE = 2
 EXIT_ENVIRONMENT = 3
+#: Every command's exit statuses, in one table (docs/cli.md, "Exit codes"; each --help's
+#: epilog): status, meaning.
+EXIT_CODES = (
+    (0, "success"),
+    (EXIT_FAILED_RUN, "a run, or a sweep's case, failed numerically (its summary or row "
+                      "says why)"),
+    (EXIT_USAGE, "bad input: one line 'loopsim: error: ...' on stderr, nothing written"),
+    (EXIT_ENVIRONMENT, "the machine's fault: disk full, read-only filesystem, I/O error, "
+                       "no memory or file handles left (re-run once fixed: sweeps resume)"),
+    (130, "stopped by SIGINT (Ctrl-C: a sweep keeps its finished cases)"),
+    (143, "stopped by SIGTERM (as 130)"),
+)
+#: The epilog of every command's --help: the exit statuses in one paragraph.
+EXIT_EPILOG = "Exit status: " + "; ".join(f"{code} {text}" for code, text in EXIT_CODES) + \
+    " (docs/cli.md)."
+#: Where the units of every option are defined.
+UNITS = "docs/model.md#units"
 
 
 class HelpFormatter(argparse.ArgumentDefaultsHelpFormatter):
@@ -57,21 +74,28 @@ def add_model_options(parser):
                         "nonlocal (full slender-body theory, needs --slenderness; "
                         "docs/nonlocal.md)")
     parser.add_argument("--slenderness", type=real, default=None, metavar="EPS",
-                        help="with --model nonlocal: filament radius over loop length, a/L, "
-                        f"in (0, {MAX_SLENDERNESS:g}]; n must stay below the mode where "
+                        help="with --model nonlocal: the slenderness EPS = a/L, filament radius "
+                        f"over loop length (dimensionless), in (0, {MAX_SLENDERNESS:g}]; n must "
+                        "stay below the mode where "
                         "slender-body theory fails (n <= 10 at 1e-2, <= 108 at 1e-3)")
 
 
 def add_integration_options(parser):
     """Options shared by every command that integrates loops."""
     add_model_options(parser)
-    parser.add_argument("--t-end", type=real, default=DEFAULT_T_END, help="final time")
-    parser.add_argument("--rtol", type=real, default=DEFAULT_RTOL, help="relative tolerance")
-    parser.add_argument("--atol", type=real, default=DEFAULT_ATOL, help="absolute tolerance")
-    parser.add_argument("--w", type=real, default=DEFAULT_W, help="length-penalty rate")
-    parser.add_argument("--perturbation", type=real, default=DEFAULT_PERTURBATION, metavar="EPS",
-                        help="RMS size of the seeded initial perturbation (0: exact circle; "
-                        f"default: {DEFAULT_PERTURBATION:g}, or 0 with --initial)")
+    parser.add_argument("--t-end", type=real, default=DEFAULT_T_END, metavar="T",
+                        help=f"final time, in t_u ({UNITS})")
+    parser.add_argument("--rtol", type=real, default=DEFAULT_RTOL, metavar="RTOL",
+                        help="relative tolerance of the time integration (dimensionless)")
+    parser.add_argument("--atol", type=real, default=DEFAULT_ATOL, metavar="ATOL",
+                        help="absolute tolerance of the time integration, on the shape "
+                        "coefficients, in L/2pi")
+    parser.add_argument("--w", type=real, default=DEFAULT_W, metavar="W",
+                        help="length-penalty rate of the inextensibility constraint, in 1/t_u")
+    parser.add_argument("--perturbation", type=real, default=DEFAULT_PERTURBATION,
+                        metavar="SIZE",
+                        help="RMS size of the seeded initial perturbation, in L/2pi (0: exact "
+                        f"circle; default: {DEFAULT_PERTURBATION:g}, or 0 with --initial)")
     parser.add_argument("--method", default=None, choices=sorted(METHODS) + ["auto"],
                         help="time integrator: rkf45 (explicit, the paper's), radau5 "
                         "(implicit: stiff stable and in-plane loops, any n >= 8) or auto "
@@ -81,13 +105,13 @@ def add_integration_options(parser):
                         help="skip the twin run at 10x stricter tolerances that says whether "
                         "each outcome is determined (the twin costs more than the run "
                         "itself; 'determined' is then empty)")
-    parser.add_argument("--n-max", type=int, default=None,
+    parser.add_argument("--n-max", type=int, default=None, metavar="N",
                         help=f"with --n auto: the highest truncation order a case may reach "
                         f"(default: {DEFAULT_N_MAX})")
-    parser.add_argument("--tail-tol", type=real, default=None,
-                        help="with --n auto: restart a case at the next order when its "
-                        "spectral tail (the top two modes' share of the deformation) passes "
-                        f"this (default: {DEFAULT_TAIL_TOL:g})")
+    parser.add_argument("--tail-tol", type=real, default=None, metavar="TOL",
+                        help="with --n auto: restart a case at the next order, from the start, "
+                        "when its spectral tail (the top two modes' share of the deformation, "
+                        f"dimensionless) passes TOL (default: {DEFAULT_TAIL_TOL:g})")
 
 
 def check_auto_options(args, n_start=DEFAULT_N):
@@ -136,9 +160,11 @@ def _is_program():
     return is_program()
 
 
-def print_and_write(table, out, meta, shown=None):
+def print_and_write(table, out, meta, shown=None, *, declarations):
     """Print ``table`` (its ``shown`` columns) and write it to ``out`` (Parquet, atomic,
-    with loopsim's provenance and ``meta`` in its metadata) when given."""
+    with loopsim's provenance and ``meta`` in its metadata, and each column's unit and
+    description from ``declarations``, a table of ``loopsim.columns``: a column it does
+    not declare is a KeyError, before anything is written) when given."""
     import pandas as pd
     import pyarrow as pa
 
@@ -148,9 +174,16 @@ def print_and_write(table, out, meta, shown=None):
         print(table[shown or list(table.columns)].to_string(
             index=False, float_format=lambda v: f"{v:.4g}"))
     if out is not None:
-        io.write_table_atomically(pa.Table.from_pandas(table, preserve_index=False)
-                                  .replace_schema_metadata(io.provenance(**meta)), out)
+        io.write_table_atomically(io.described(
+            pa.Table.from_pandas(table, preserve_index=False)
+            .replace_schema_metadata(io.provenance(**meta)), declarations), out)
         print(f"table: {out}")
+
+
+def directory_name(path):
+    """The last component of a directory's path: what a table's metadata records of the
+    directory it came from (never the machine's full path)."""
+    return os.path.basename(os.path.normpath(path))
 
 
 def use_agg():

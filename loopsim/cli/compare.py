@@ -1,6 +1,6 @@
 """``loopsim compare``: whether two sweeps of the same cells differ in distribution, cell
 by cell."""
-from .common import HelpFormatter, print_and_write, real
+from .common import HelpFormatter, directory_name, print_and_write, real
 
 
 def add_parser(commands):
@@ -15,15 +15,17 @@ def add_parser(commands):
     )
     compare.add_argument("sweep_a", metavar="SWEEP_A", help="a sweep directory")
     compare.add_argument("sweep_b", metavar="SWEEP_B", help="another, of the same cells")
-    compare.add_argument("--alpha", type=real, default=0.05,
-                         help="significance level of the verdict (Bonferroni over 3 tests)")
+    compare.add_argument("--alpha", type=real, default=0.05, metavar="P",
+                         help="significance level (a probability) of the verdict (Bonferroni "
+                         "over 3 tests)")
     compare.add_argument("--out", metavar="FILE.parquet", help="also write the table to Parquet")
-    compare.add_argument("--seed", type=int, default=0, help="seed of the bootstrap (>= 0)")
+    compare.add_argument("--seed", type=int, default=0, metavar="SEED",
+                         help="seed of the bootstrap (>= 0)")
     return compare
 
 
 def command(args):
-    from .. import io, summary, validation
+    from .. import columns, io, summary, validation
 
     validation.check_integer("--seed", args.seed, 0)
     validation.check_real("--alpha", args.alpha, low=0.0, high=1.0, low_open=True)
@@ -31,8 +33,9 @@ def command(args):
         validation.check_output_file("--out", args.out)
     table = summary.compare(io.read_results(args.sweep_a), io.read_results(args.sweep_b),
                             alpha=args.alpha, seed=args.seed)
-    print_and_write(table, args.out, dict(table.attrs["loopsim_compare"],
-                                           compared=[args.sweep_a, args.sweep_b]))
+    print_and_write(table, args.out, dict(table.attrs["loopsim_compare"], compared=[
+        directory_name(args.sweep_a), directory_name(args.sweep_b)]),
+                    declarations=columns.COMPARE_COLUMNS)
     counts = table["verdict"].value_counts().to_dict()
     print(", ".join(f"{v} cell(s) {k}" for k, v in sorted(counts.items())))
     return 0

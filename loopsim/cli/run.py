@@ -31,15 +31,17 @@ def add_parser(commands):
         formatter_class=HelpFormatter,
     )
     run.add_argument("--g0", type=real,
-                     help="gravity over bending stiffness, g0 = L^3 g rho_L / (8 pi^3 EI) >= 0 "
-                     "(required, except when continuing from results: then their g0)")
+                     help="gravity over bending stiffness, g0 = L^3 g rho_L / (8 pi^3 EI) >= 0, "
+                     "dimensionless (required, except when continuing from results: then their "
+                     "g0)")
     run.add_argument("--theta0", type=real, metavar="DEG",
                      help="initial tilt of the loop's plane to the horizontal, in [0, 90] degrees "
                      "(not with --initial: the tilt is measured)")
-    run.add_argument("--n", type=_order, default=None,
-                     help=f"Fourier truncation order (1..128; default: {DEFAULT_N}, or the stored "
-                     "order of --initial results), or auto: start there and raise n during "
-                     "the run whenever the spectral tail passes --tail-tol")
+    run.add_argument("--n", type=_order, default="auto", metavar="N|auto",
+                     help="Fourier truncation order (1..128), or auto: start at n = "
+                     f"{DEFAULT_N} (an --initial shape: at the order its content needs) and "
+                     "restart the run from t = 0 at the next order whenever the spectral tail "
+                     "passes --tail-tol (the paper's scheme: --n 6 --method rkf45)")
     run.add_argument("--initial", metavar="FILE|DIR",
                      help="start from a shape: a CSV/Parquet point file (columns x, y, z, in "
                      "order along the closed curve) or results (run --out file, sweep dir)")
@@ -47,7 +49,8 @@ def add_parser(commands):
                      help="with --initial results: the case whose terminal shape starts the run")
     add_integration_options(run)
     run.set_defaults(perturbation=None)
-    run.add_argument("--seed", type=int, default=DEFAULT_SEED, help="perturbation seed (>= 0)")
+    run.add_argument("--seed", type=int, default=DEFAULT_SEED, metavar="SEED",
+                     help="perturbation seed (>= 0)")
     run.add_argument("--snapshots", type=int, default=2, metavar="K",
                      help="states stored of the trajectory: K equally spaced times, both "
                      "ends included (as sweep --snapshots; here the start and the end by "
@@ -74,10 +77,15 @@ def _load_initial_for_run(args):
     if args.theta0 is not None:
         raise ValueError("give --theta0 or --initial, not both (the tilt of an --initial shape "
                          "is measured from it)")
-    if args.n not in (None, "auto") and args.n < 1:
+    if args.n != "auto" and args.n < 1:
         raise ValueError(f"n must be an integer >= 1, got {args.n}")
-    x, info = shapes.load_initial(args.initial, None if args.n == "auto" else args.n,
-                                  args.case_id)
+    n = args.n
+    if n == "auto":  # a point file at the order its content needs; results at their own
+        from .. import api, models
+
+        n = shapes.auto_start_order(args.initial, args.case_id, high=api.ladder_top(
+            models.choose(args.model, args.slenderness), args.n_max))
+    x, info = shapes.load_initial(args.initial, n, args.case_id)
     g0 = args.g0 if args.g0 is not None else info.get("g0")
     if g0 is None:
         raise ValueError("--g0 is required (only results carry a g0 to continue with)")
@@ -96,7 +104,7 @@ def _check_run_sizes(args):
     """--n, --n-max and --snapshots within their documented bounds, before any work."""
     from .. import validation
 
-    if args.n not in (None, "auto"):
+    if args.n != "auto":
         validation.check_order("--n", args.n)
     check_auto_options(args)
     validation.check_count("--snapshots", args.snapshots, 1, validation.MAX_SNAPSHOTS,

@@ -22,26 +22,28 @@ def add_parser(commands):
     full.add_argument("--n", type=int, default=None,
                       help="truncation order of the full linearisation (>= 3; default: 16)")
     full.add_argument("--theta0", type=real, default=None, metavar="DEG",
-                      help="tilt of the circle in (0, 90] (default: 90; the rates depend on q only)")
-    full.add_argument("--w", type=real, default=None,
-                      help=f"length-penalty rate (default: {DEFAULT_W:g})")
+                      help="tilt of the circle in (0, 90] degrees (default: 90; the rates depend "
+                      "on q only)")
+    full.add_argument("--w", type=real, default=None, metavar="W",
+                      help=f"length-penalty rate, in 1/t_u (default: {DEFAULT_W:g})")
     full.add_argument("--q-scan", metavar="START:STOP:NUM|v1,v2,...",
-                      help="also the largest growth rate of each sector, the paper's and the "
-                      "corrected operator at these q")
-    full.add_argument("--g0", type=real, metavar="G",
-                      help="also the spectrum at (G, --theta0): the --top largest eigenvalues "
-                      "with sector labels")
-    full.add_argument("--top", type=int, default=None,
+                      help="also the largest growth rate (in 1/t_u) of each sector, the "
+                      "paper's and the corrected operator at these q (dimensionless)")
+    full.add_argument("--g0", type=real, metavar="G0",
+                      help="also the spectrum at g0 = G0 (dimensionless) and --theta0: the --top "
+                      "largest eigenvalues (growth rates, in 1/t_u) with sector labels")
+    full.add_argument("--top", type=int, default=None, metavar="K",
                       help="eigenvalues listed with --g0 (default: 12)")
-    full.add_argument("--onset", type=real, nargs=3, metavar=("EPS", "T_END", "DETECT"),
-                      help="also the q where a mode of size EPS reaches DETECT at T_END, per sector")
+    full.add_argument("--onset", type=real, nargs=3, metavar=("SIZE", "T", "DETECT"),
+                      help="also the q where a mode of size SIZE (in L/2pi) reaches size DETECT "
+                      "(in L/2pi) at time T (in t_u), per sector")
     full.add_argument("--figure", metavar="PNG",
                       help="draw growth rates vs q (paper's operator beside the full sectors)")
     add_model_options(full)
     paper_group = stability.add_argument_group("the paper's operator (--paper)")
     paper_group.add_argument("--paper", action="store_true",
                              help="the table of the paper's operator for n = 1..--n-max instead")
-    paper_group.add_argument("--n-max", type=int, default=None,
+    paper_group.add_argument("--n-max", type=int, default=None, metavar="N",
                              help="largest truncation order of the --paper table (default: 60)")
     return stability
 

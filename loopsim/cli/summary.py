@@ -1,8 +1,8 @@
 """``loopsim summary``: one row per cell of a sweep (regime probabilities, medians, with
 intervals), printed and optionally written and drawn."""
-import os
-
-from .common import HelpFormatter, print_and_write, save_distribution_figure
+from .common import (
+    HelpFormatter, directory_name, print_and_write, save_distribution_figure,
+)
 
 
 def add_parser(commands):
@@ -19,7 +19,8 @@ def add_parser(commands):
     )
     summary.add_argument("sweep_dir", metavar="SWEEP_DIR", help="a sweep directory")
     summary.add_argument("--out", metavar="FILE.parquet", help="also write the table to Parquet")
-    summary.add_argument("--seed", type=int, default=0, help="seed of the bootstrap (>= 0)")
+    summary.add_argument("--seed", type=int, default=0, metavar="SEED",
+                         help="seed of the bootstrap (>= 0)")
     summary.add_argument("--figure", metavar="PNG",
                          help="also draw P(3D) per cell, the terminal tilt over seeds and the "
                          "aspect ratio over the steady branch")
@@ -27,7 +28,7 @@ def add_parser(commands):
 
 
 def command(args):
-    from .. import io, summary, validation
+    from .. import columns, io, summary, validation
 
     validation.check_integer("--seed", args.seed, 0)
     for name, path in (("--out", args.out), ("--figure", args.figure)):
@@ -44,7 +45,8 @@ def command(args):
         "seeds", "determined", "p_stable", "p_in_plane", "p_3d", "p_3d_low", "p_3d_high",
         "tilt_median", "tilt_median_low", "tilt_median_high"]
     print_and_write(table, args.out, dict(table.attrs["loopsim_summary"],
-                                           summary_of=os.path.abspath(args.sweep_dir)), shown)
+                                           summary_of=directory_name(args.sweep_dir)),
+                    shown, declarations=columns.SUMMARY_COLUMNS)
     if args.figure is not None:
         save_distribution_figure(table, frame, args.figure)
         print(f"figure: {args.figure}")

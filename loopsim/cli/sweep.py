@@ -38,19 +38,20 @@ def add_parser(commands):
         description="Integrate many loops in parallel and write one row per case into "
         "chunk files in DIR, a Parquet dataset (pandas.read_parquet(DIR); checked: "
         "loopsim.read_results(DIR)). Re-running the same command resumes (also with another "
-        "--chunk-size). Exit status: 0 every case ok; 1 some case failed (its row says why; "
-        "see --rerun-failed); 2 bad input; 3 disk full, read-only filesystem or I/O error "
-        "(re-run to resume once fixed); 130 / 143 stopped by SIGINT / SIGTERM (finished "
-        "cases kept: re-run to resume).",
+        "--chunk-size, after an exit 3 once the disk is fixed, or after a signal: finished "
+        "cases are kept). Exit 1: some case failed (its row says why; see --rerun-failed).",
         formatter_class=HelpFormatter,
     )
     grid = sweep.add_argument_group("cases (a grid, or --cases FILE)")
-    grid.add_argument("--g0", metavar="START:STOP:NUM|v1,v2,...", help="g0 values")
-    grid.add_argument("--theta0", metavar="START:STOP:NUM|v1,v2,...", help="theta0 values (deg)")
-    grid.add_argument("--n", default=str(DEFAULT_N), metavar="N[,N...]|auto",
+    grid.add_argument("--g0", metavar="START:STOP:NUM|v1,v2,...",
+                      help="g0 values (gravity over bending stiffness, dimensionless)")
+    grid.add_argument("--theta0", metavar="START:STOP:NUM|v1,v2,...",
+                      help="initial tilts, in degrees")
+    grid.add_argument("--n", default="auto", metavar="N[,N...]|auto",
                       help="truncation orders, or auto: every case starts at n = "
-                      f"{DEFAULT_N} and climbs (up to --n-max) whenever its spectral tail passes "
-                      "--tail-tol")
+                      f"{DEFAULT_N} and is restarted from t = 0 at the next order (up to "
+                      "--n-max) whenever its spectral tail passes --tail-tol (the paper's "
+                      "scheme: --n 6 --method rkf45)")
     grid.add_argument("--seeds", default="1", metavar="K|auto",
                       help="seeds 0..K-1 per point, or auto: per point 4, 8, 16 ... seeds "
                       "until its answer is sharp (see --p-halfwidth; docs/distributions.md)")
@@ -58,6 +59,11 @@ def add_parser(commands):
                       "[, n, seed, perturbation, initial, initial_case_id] instead of a grid "
                       "(initial: a point file or results per row, paths relative to FILE; "
                       "theta0_deg then left empty)")
+    integration = sweep.add_argument_group("integration of each case")
+    add_integration_options(integration)
+    integration.add_argument("--no-early-stop", action="store_true",
+                             help="always integrate to --t-end (default: stop once the shape "
+                             "and tilt are steady, see docs/sweeps.md)")
     sharp = sweep.add_argument_group(
         "--seeds auto: seeds added per point until it is deterministic (every seed in one "
         "regime, tilts within 1 deg, aspect ratios within 0.1), sharp (both targets met) or at "
@@ -66,35 +72,34 @@ def add_parser(commands):
         sharp.add_argument("--" + name.replace("_", "-"), type=real if metavar != "K" else int,
                            default=None, metavar=metavar,
                            help=f"{text} (default: {SEED_TARGETS[name][1]})")
-    add_integration_options(sweep)
-    sweep.add_argument("--no-early-stop", action="store_true",
-                       help="always integrate to --t-end (default: stop once the shape and tilt "
-                       "are steady, see docs/sweeps.md)")
-    sweep.add_argument("--snapshots-for", metavar="CASE_IDS", default="",
+    output = sweep.add_argument_group("output")
+    output.add_argument("--snapshots-for", metavar="CASE_IDS", default="",
                        help="case ids (v1,v2,...) whose trajectories are stored as snapshots")
-    sweep.add_argument("--snapshots", type=int, default=101, metavar="K",
+    output.add_argument("--snapshots", type=int, default=101, metavar="K",
                        help="states stored of each --snapshots-for trajectory: K equally "
                        "spaced times, both ends included (as run --snapshots)")
-    sweep.add_argument("--threads", type=int, default=None, help="threads (default: all cores)")
-    sweep.add_argument("--chunk-size", type=int, default=None,
+    output.add_argument("--threads", type=int, default=None, metavar="K",
+                       help="threads (default: all cores)")
+    output.add_argument("--chunk-size", type=int, default=None, metavar="K",
                        help="cases per chunk file (and per Dask task; default "
                        f"{DEFAULT_CHUNK_SIZE}, or {DEFAULT_AUTO_CHUNK_SIZE} with --n auto, "
                        "whose cases take minutes: a SIGKILL loses the unwritten chunks); may "
                        "change on resume")
-    sweep.add_argument("--out", metavar="DIR",
+    output.add_argument("--out", metavar="DIR",
                        help="sweep directory, made if absent (required, except with "
                        "--rerun-failed)")
-    sweep.add_argument("--figure", metavar="PNG", help="also draw the phase diagram")
-    sweep.add_argument("--quiet", action="store_true", help="no progress line, only a summary")
-    sweep.add_argument("--progress-every", type=real, default=30.0, metavar="SECONDS",
-                       help="progress line interval when stderr is not a terminal (a log file)")
+    output.add_argument("--figure", metavar="PNG", help="also draw the phase diagram")
+    output.add_argument("--quiet", action="store_true", help="no progress line, only a summary")
+    output.add_argument("--progress-every", type=real, default=30.0, metavar="SECONDS",
+                       help="progress line interval, in seconds of wall time, when stderr is "
+                       "not a terminal (a log file)")
     where = sweep.add_argument_group("where the cases run (default: this machine's threads)")
     where.add_argument("--scheduler", metavar="ADDRESS",
                        help="send chunks as tasks to the Dask scheduler at ADDRESS "
                        "(tcp://host:8786); finished chunks come back and are written here")
     where.add_argument("--dask", action="store_true",
                        help="start a Dask LocalCluster here and send chunks to it")
-    where.add_argument("--workers", type=int, default=None,
+    where.add_argument("--workers", type=int, default=None, metavar="K",
                        help="with --dask: worker processes, at most the cores (default: "
                        "cores / --threads)")
     where.add_argument("--shard", metavar="I/N",
@@ -146,7 +151,12 @@ def _sweep_config(args, sweeps):
             raise ValueError("give either --cases or --g0/--theta0, not both")
         orders = [DEFAULT_N] if args.n == "auto" else sweeps.parse_values(args.n, "--n",
                                                                            integer=True)
-        cases = sweeps.read_cases_file(args.cases, args.perturbation, orders[0])
+        top = None
+        if args.n == "auto":  # point files start at the order their content needs
+            from .. import api, models
+
+            top = api.ladder_top(models.choose(args.model, args.slenderness), args.n_max)
+        cases = sweeps.read_cases_file(args.cases, args.perturbation, orders[0], top)
     else:
         if not (args.g0 and args.theta0):
             raise ValueError("a sweep needs --g0 and --theta0 (or --cases FILE)")

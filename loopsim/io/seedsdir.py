@@ -117,16 +117,80 @@ def read_seeds_auto(out):
 
 
 def read_results(out):
-    """All finished cases of a sweep directory (``sweepdir.read_results``) or of a
-    ``--seeds auto`` directory (:func:`read_seeds_auto`) as a DataFrame."""
+    """All finished cases of a sweep directory as a DataFrame sorted by ``case_id``.
+
+    The same rows as ``pandas.read_parquet(out)``, checked: every result file must read
+    back whole with its page checksums and content hash (a damaged file is a one-line
+    ValueError naming it: re-running the sweep's command moves it aside and recomputes
+    its cases), carry the fingerprint of the configuration in ``_sweep.json`` and hold
+    exactly the cases its name says; no case may appear twice.  A ``--seeds auto``
+    directory is read round by round (:func:`read_seeds_auto`): its rows get a ``round``
+    column and ``case_id`` is renumbered in (round, case_id) order.
+
+    Parameters
+    ----------
+    out : str
+        A sweep directory (``loopsim sweep --out``, :func:`loopsim.sweep`) or a
+        ``--seeds auto`` directory.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per finished case, with the columns of ``loopsim.columns.RESULT_COLUMNS``
+        (inputs, run statistics, the terminal state's diagnostics, ``regime``,
+        ``resolved``, ``determined``, ``x_final`` in L/2π; units in docs/sweeps.md).
+        ``frame.attrs["loopsim"]`` holds the sweep's configuration, thresholds,
+        versions, command line, reruns and each column's unit and description.  A sweep
+        still running gives the cases finished so far.
+
+    Raises
+    ------
+    ValueError
+        ``out`` is not a sweep directory, has lost its ``_sweep.json``, holds a damaged
+        file, a file of another sweep or a case twice, or is a layout-1 directory
+        (loopsim 0.2.0 and earlier releases).
+
+    Examples
+    --------
+    >>> import loopsim
+    >>> frame = loopsim.read_results("runs/phase")  # doctest: +SKIP
+    >>> frame.groupby("regime").size()  # doctest: +SKIP
+    """
     if os.path.isdir(out) and is_seeds_auto(out):
         return read_seeds_auto(out)
     return sweepdir.read_results(out)
 
 
 def read_stop_table(out):
-    """The stop table of a finished ``--seeds auto`` directory: one row per cell (its
-    inputs, ``seeds``, ``rounds``, ``stop_reason``, ``p_halfwidth``, ``tilt_halfwidth_deg``)."""
+    """The stop table of a finished ``--seeds auto`` directory: why each cell stopped.
+
+    Parameters
+    ----------
+    out : str
+        A ``--seeds auto`` directory whose sweep has finished.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per cell, with the columns of ``loopsim.columns.STOP_COLUMNS`` (its
+        inputs, ``seeds``, ``rounds``, ``stop_reason``, ``p_halfwidth``,
+        ``tilt_halfwidth_deg`` in degrees, ``runs``, ``twins`` and the distribution check of
+        sampled cells); each column's unit and description are in the file's field
+        metadata.
+
+    Raises
+    ------
+    ValueError
+        The sweep has not finished (no stop table yet).
+    loopsim.io.DamagedFile
+        The stop table fails its checksums or content hash.
+
+    Examples
+    --------
+    >>> from loopsim import io
+    >>> stops = io.read_stop_table("runs/seeds")  # doctest: +SKIP
+    >>> stops[["g0", "theta0_deg", "seeds", "stop_reason"]]  # doctest: +SKIP
+    """
     path = os.path.join(out, STOPS_FILE)
     if not os.path.isfile(path):
         raise ValueError(f"{out!r} has no {STOPS_FILE}: its --seeds auto sweep has not "

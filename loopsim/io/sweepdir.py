@@ -29,7 +29,10 @@ RERUN_DIR = "_reruns"
 LAYOUT = 2
 CHUNK_PATTERN = "chunk-{:07d}-{:07d}.parquet"
 _CHUNK_NAME = re.compile(r"chunk-(\d{7,})-(\d{7,})\.parquet")
-#: Names of the first layout (loopsim 0.2.0 and before): refused with a one-line error.
+#: Names of layout 1, the only layout of the 0.2.0 release and those before it: refused with
+#: a one-line error.  Layout 2 (``_sweep.json``, whose ``layout`` field says 2) is the layout
+#: of 0.3.0; the development builds between the two releases, whose tables still say
+#: ``loopsim_version`` 0.2.0, wrote layout 2 too, so the layout, not the version, decides.
 _OLD_LAYOUT = re.compile(r"sweep\.json|(chunk|snapshots)-\d{5}\.parquet")
 #: Configuration fields that change no row: left out of the fingerprint, so a resume may
 #: change them.
@@ -73,7 +76,8 @@ def check_layout(directory):
     old = sorted(name for name in os.listdir(directory) if _OLD_LAYOUT.fullmatch(name))
     if old:
         raise ValueError(
-            f"{directory!r} is a sweep directory of loopsim <= 0.2.0 ({old[0]}): this version "
+            f"{directory!r} is a layout-1 sweep directory (loopsim 0.2.0 and earlier releases; "
+            f"{old[0]}): this version "
             "neither resumes nor reads it; re-run the sweep into a new --out (its chunk files "
             f"stay readable with pandas.read_parquet({os.path.join(directory, 'chunk-*.parquet')!r}"
             " file by file)")
@@ -146,8 +150,36 @@ def quarantine(directory, path, reason):
 
 
 def read_snapshots(out):
-    """Trajectory snapshots of the cases chosen with ``snapshots_for`` (a DataFrame): the
-    snapshot files whose result file is there (one cut short has none)."""
+    """The stored trajectories of a sweep: one row per snapshot of each case chosen with
+    ``snapshots_for`` (``--snapshots-for``).
+
+    Only the snapshot files whose result file is there are read (a piece cut short has
+    none), each checked (page checksums, content hash).
+
+    Parameters
+    ----------
+    out : str
+        A sweep directory.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The columns of ``loopsim.columns.TRAJECTORY_COLUMNS`` (``case_id``, ``t`` in t_u,
+        ``theta_deg``, ``x`` in L/2π ...), sorted by (case_id, t); empty when no
+        snapshot was stored or ``out`` does not exist.
+
+    Raises
+    ------
+    ValueError
+        A damaged snapshot file (named; the sweep's command recomputes it), or a
+        layout-1 directory.
+
+    Examples
+    --------
+    >>> import loopsim
+    >>> loopsim.sweep(150, 60, "runs/one", n=6, snapshots_for=[0])  # doctest: +SKIP
+    >>> loopsim.read_snapshots("runs/one").groupby("case_id")["t"].max()  # doctest: +SKIP
+    """
     if not os.path.isdir(out):
         return pd.DataFrame()
     check_layout(out)

@@ -58,9 +58,33 @@ RESULT_SCHEMA = pa.schema(
 
 
 def coefficients(row):
-    """The (3, 2n + 1) coefficient array of a results row's ``x_final`` (a row of
-    :func:`read_results`, a dict, or the list itself): x, y, z, each [a0, a1..an,
-    b1..bn] (``COEFFICIENT_LAYOUT``)."""
+    """The terminal shape of a results row as a (3, 2n + 1) coefficient array.
+
+    Parameters
+    ----------
+    row : pandas.Series, dict or array_like
+        A row of :func:`loopsim.read_results` (or a dict) with the column ``x_final``, or
+        that column's value itself (3 (2n + 1) numbers, row-major).
+
+    Returns
+    -------
+    numpy.ndarray
+        Shape (3, 2n + 1), in L/2π: rows x, y, z, each [a0, a1..an, b1..bn] with
+        f(s) = a0 + Σ a_k cos ks + b_k sin ks (``COEFFICIENT_LAYOUT``).
+
+    Raises
+    ------
+    KeyError
+        ``row`` has no ``x_final``.
+    ValueError
+        The values cannot be laid out as three rows.
+
+    Examples
+    --------
+    >>> import loopsim
+    >>> loopsim.coefficients([0.0, 1.0, 0.0] + [0.0] * 6).shape
+    (3, 3)
+    """
     values = row if isinstance(row, (list, tuple, np.ndarray)) else row["x_final"]
     return np.asarray(values, dtype=float).reshape(3, -1)
 

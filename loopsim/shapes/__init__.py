@@ -10,11 +10,13 @@ from .circle import (
 )
 from .curvefit import check_points, fit_points
 from .loading import (
-    TAIL_WARNING, check_coefficients, from_coefficients, initial_case, load_initial,
-    points_shape, read_points, resolve_initial, shape_info, start_shape,
+    TAIL_WARNING, auto_start_order, check_coefficients, content_order, from_coefficients,
+    initial_case, load_initial, points_shape, read_points, resolve_initial, shape_info,
+    start_shape,
 )
 
 __all__ = ["default_perturbation", "inclined_circle", "initial_shape", "perturb",
            "perturbation_field", "check_points", "fit_points", "TAIL_WARNING",
-           "check_coefficients", "from_coefficients", "initial_case", "load_initial",
-           "points_shape", "read_points", "resolve_initial", "shape_info", "start_shape"]
+           "auto_start_order", "check_coefficients", "content_order",
+           "from_coefficients", "initial_case", "load_initial", "points_shape",
+           "read_points", "resolve_initial", "shape_info", "start_shape"]

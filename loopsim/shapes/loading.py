@@ -28,7 +28,7 @@ import os
 import numpy as np
 
 from .. import diagnostics, io, spectral, validation
-from ..config import DEFAULT_N
+from ..config import DEFAULT_N, INITIAL_CONTENT_TOL
 from .circle import default_perturbation, initial_shape, perturb
 from .curvefit import fit_points
 
@@ -85,10 +85,32 @@ def read_points(path):
 
 
 def points_shape(points, n, source="points"):
-    """Order-n shape through ``points`` (``curvefit.fit_points``) and its info."""
+    """Order-n shape through ``points`` (``curvefit.fit_points``) and its info, with
+    ``content_order``: the order the fitted curve needs (:func:`content_order`)."""
     x, fine, info = fit_points(points, n, source)
-    info.update(shape_info(x, fine, n))
+    info.update(shape_info(x, fine, n), content_order=content_order(fine))
     return x, info
+
+
+def content_order(fine, tol=INITIAL_CONTENT_TOL):
+    """The lowest order m >= 1 whose truncation of the series ``fine`` leaves out at most
+    ``tol`` of its RMS amplitude (``diagnostics.truncation``); fine's own order if none."""
+    top = spectral.order_of(fine.shape[-1])
+    return next((m for m in range(1, top) if diagnostics.truncation(fine, m) <= tol), top)
+
+
+def auto_start_order(initial, case_id=None, low=DEFAULT_N, high=None):
+    """The order a run with ``n="auto"`` starts a given shape at: for a point file, the
+    order its content needs (``info["content_order"]``, :data:`config.INITIAL_CONTENT_TOL`)
+    but not below ``low`` (the ladder's usual start) nor above ``high`` (its top); None for
+    coefficients and results, which start at their stored order (exact)."""
+    if not isinstance(initial, (str, os.PathLike)):
+        return None
+    _, info = load_initial(initial, None, case_id)
+    if info["kind"] != "points":
+        return None
+    order = max(low, info["content_order"])
+    return order if high is None else min(order, max(low, high))
 
 
 # ---- diagnostics --------------------------------------------------------------

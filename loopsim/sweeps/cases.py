@@ -69,7 +69,7 @@ class SweepConfig:
     steady_interval: float = DEFAULT_STEADY_INTERVAL
     steady_tol: float = DEFAULT_STEADY_TOL
     thresholds: Thresholds = Thresholds()
-    n_auto: bool = False  # raise n during each run (loopsim.refinement)
+    n_auto: bool = False  # restart a case from t0 at the next order past tail_tol (refinement)
     n_max: int = DEFAULT_N_MAX
     tail_tol: float = DEFAULT_TAIL_TOL
     twin: bool = True  # run each case's stricter twin (loopsim.outcomes: determined or not)
@@ -180,10 +180,12 @@ def case_model(config, case):
                          if name == "nonlocal" else None)
 
 
-def read_cases_file(path, perturbation=DEFAULT_PERTURBATION, n=6):
+def read_cases_file(path, perturbation=DEFAULT_PERTURBATION, n=6, auto_top=None):
     """Cases from a CSV or Parquet table: columns g0, theta0_deg (required), n, seed,
     perturbation, and per case (overriding the sweep's options) method, rtol, t_end,
-    model, slenderness."""
+    model, slenderness.  ``auto_top``: with ``--n auto``, the ladder's top; a row that
+    starts from a point file (column ``initial``) and gives no n then starts at the order
+    its content needs (``shapes.auto_start_order``), as ``run --initial`` does."""
     validation.check_input_file("cases file", path, validation.MAX_CASES_FILE_BYTES)
     limit = validation.MAX_CASES
     try:
@@ -208,17 +210,24 @@ def read_cases_file(path, perturbation=DEFAULT_PERTURBATION, n=6):
     if missing:
         raise ValueError(f"cases file {path!r} lacks column(s) {sorted(missing)}")
     given = frame.notna() if "initial" in frame.columns else None  # per-cell: value given?
+    n_given = "n" in frame.columns
     frame = frame.assign(**{k: v for k, v in dict(n=n, seed=0, perturbation=perturbation,
                                                   theta0_deg=math.nan).items() if k not in frame})
     cases = [_case_row(path, i, row) for i, row in enumerate(frame.itertuples())]
     for i, case in enumerate(cases):  # optional column initial (file or results), initial_case_id
         if given is not None and given["initial"].iloc[i] and str(frame["initial"].iloc[i]).strip():
             case_id = frame["initial_case_id"].iloc[i] if "initial_case_id" in frame else None
+            case_id = None if case_id is None or pd.isna(case_id) else int(case_id)
+            source = str(frame["initial"].iloc[i]).strip()
             try:
+                if auto_top is not None and not (n_given and given["n"].iloc[i]):
+                    where = source if os.path.isabs(source) else os.path.normpath(
+                        os.path.join(os.path.dirname(str(path)), source))
+                    order = shapes.auto_start_order(where, case_id, n, auto_top)
+                    case = dict(case, n=case["n"] if order is None else order)
                 cases[i] = shapes.initial_case(
-                    case, str(frame["initial"].iloc[i]).strip(),
-                    None if case_id is None or pd.isna(case_id) else int(case_id),
-                    os.path.dirname(str(path)),
+                    case, source,
+                    case_id, os.path.dirname(str(path)),
                     "perturbation" in given and bool(given["perturbation"].iloc[i]))
             except ValueError as exc:
                 raise ValueError(f"cases file row {i}: {exc}") from None

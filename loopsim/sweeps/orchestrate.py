@@ -1,14 +1,17 @@
 """The top level of a sweep: :func:`run_sweep` (check, prepare the directory, plan the
 pieces, hand them to a backend, read the table back) and its Python form :func:`sweep`."""
-import dataclasses
 import os
 
 import numpy as np
 
 from .. import io, seeding, validation
 from ..config import (
-    DEFAULT_AUTO_CHUNK_SIZE, DEFAULT_CHUNK_SIZE, DEFAULT_N, DEFAULT_PERTURBATION, SEED_TARGETS,
+    DEFAULT_ATOL, DEFAULT_AUTO_CHUNK_SIZE, DEFAULT_CHUNK_SIZE, DEFAULT_LENGTH_TOL,
+    DEFAULT_MAX_STEPS, DEFAULT_N, DEFAULT_N_MAX, DEFAULT_PERTURBATION, DEFAULT_RTOL,
+    DEFAULT_STEADY_INTERVAL, DEFAULT_STEADY_TOL, DEFAULT_T_END, DEFAULT_TAIL_TOL, DEFAULT_W,
+    SEED_TARGETS,
 )
+from ..outcomes import Thresholds
 from .cases import SweepConfig, grid_cases, validate
 from .chunks import canonical_chunks, covered_ids, pending_pieces
 from .dask_backend import close_cluster, dask_client, run_dask
@@ -98,23 +101,124 @@ def run_sweep(config, out, threads=None, quiet=False, command_line=None, *, sche
     return io.read_results(out)
 
 
-def sweep(g0, theta0_deg, out, *, n=6, seeds=1, method=None, quiet=True, threads=None,
-          scheduler=None, local_cluster=False, workers=None, **options):
-    """The Python form of ``loopsim sweep``: every (g0, θ0, seed) of the grid into the
-    sweep directory ``out`` (made, or resumed), returned as the results DataFrame
-    (:func:`io.read_results`).
+def sweep(g0, theta0_deg, out, *, n="auto", seeds=1, method=None, t_end=DEFAULT_T_END,
+          rtol=DEFAULT_RTOL, atol=DEFAULT_ATOL, w=DEFAULT_W, perturbation=DEFAULT_PERTURBATION,
+          twin=True, early_stop=True, n_max=DEFAULT_N_MAX, tail_tol=DEFAULT_TAIL_TOL,
+          model="local", slenderness=None, max_steps=DEFAULT_MAX_STEPS,
+          length_tol=DEFAULT_LENGTH_TOL, steady_interval=DEFAULT_STEADY_INTERVAL,
+          steady_tol=DEFAULT_STEADY_TOL, thresholds=Thresholds(), snapshots_for=(),
+          snapshot_count=101, chunk_size=None, p_halfwidth=None, tilt_halfwidth=None,
+          min_seeds=None, max_seeds=None, check_seeds=None, quiet=True, threads=None,
+          scheduler=None, local_cluster=False, workers=None):
+    """Run (or resume) a sweep over a grid of (g0, θ0, n, seed): the Python form of
+    ``loopsim sweep``.
 
-    ``g0`` and ``theta0_deg``: values (numbers or sequences); ``n``: an order, a
-    sequence of orders, or "auto"; ``seeds``: seeds 0..seeds-1 per point, or "auto":
-    seeds added per cell until its answer is sharp (``--seeds auto``: rounds of sweeps,
-    ``sweeps.seeds_auto``; its targets ``p_halfwidth``, ``tilt_halfwidth`` (deg),
-    ``min_seeds``, ``max_seeds`` as keywords, defaults of ``seeding.SeedTargets``; the
-    rows get a ``round`` column; the stop table: ``io.read_stop_table(out)``);
-    ``method``: as in ``simulate`` (default rkf45 at a fixed n, auto with ``n="auto"``).
-    Every other keyword is a :class:`SweepConfig` field under its own name (``t_end``,
-    ``rtol``, ``atol``, ``w``, ``early_stop``, ``twin``, ``n_max``, ``tail_tol``,
-    ``chunk_size``, ...) or ``perturbation``.  Backends as :func:`run_sweep`.  The
-    directory is the one the command line writes: either may resume the other.
+    Every case of the grid is integrated into the sweep directory ``out`` (made, or
+    resumed: the directory is the one the command line writes, and either may resume the
+    other), and the rows are read back (:func:`loopsim.read_results`).
+
+    Parameters
+    ----------
+    g0 : float or sequence of float
+        Gravity over bending stiffness, L³ g ρ_L / (8π³ EI) (dimensionless, >= 0).
+    theta0_deg : float or sequence of float
+        Initial tilts of the loop's plane to the horizontal, in degrees, in [0, 90].
+    out : str or os.PathLike
+        The sweep directory.
+    n : int, sequence of int or "auto", default "auto"
+        Truncation orders (1..128), or "auto": every case starts at n = 6 and is
+        restarted from t = 0 at the next order of ``config.AUTO_ORDERS`` (up to ``n_max``)
+        whenever its spectral tail passes ``tail_tol``.  The paper's scheme is
+        ``n=6, method="rkf45"``.
+    seeds : int or "auto", default 1
+        Seeds 0..seeds-1 per grid point, or "auto": rounds of seeds per cell until its
+        answer is sharp (``p_halfwidth``, ``tilt_halfwidth``), deterministic, or at
+        ``max_seeds`` (docs/distributions.md); the rows then get a ``round`` column and
+        the stop table is ``loopsim.io.read_stop_table(out)``.
+    method : {"rkf45", "radau5", "auto"} or None, default None
+        The integrator; None means "rkf45" (the paper's scheme) at a fixed n and "auto"
+        (chosen per case) with ``n="auto"``.
+    t_end : float, default 10.0
+        Final time, in t_u (docs/model.md, "Units").
+    rtol : float, default 1e-6
+        Relative tolerance of the time integration (dimensionless).
+    atol : float, default 1e-9
+        Absolute tolerance on the shape coefficients, in L/2π.
+    w : float, default 10.0
+        Length-penalty rate of the inextensibility constraint, in 1/t_u.
+    perturbation : float, default 1e-3
+        RMS size of the seeded initial perturbation, in L/2π (0: the exact circle).
+    twin : bool, default True
+        Run each case's twin at 10x stricter tolerances, which says whether its outcome is
+        ``determined`` (about doubles the cost).
+    early_stop : bool, default True
+        Stop a case once its shape and tilt are steady (docs/sweeps.md).
+    n_max : int, default 32
+        With ``n="auto"``: the highest order a case may reach.
+    tail_tol : float, default 1e-5
+        With ``n="auto"``: the spectral-tail tolerance (dimensionless) that restarts a
+        case at the next order.
+    model : {"local", "nonlocal"}, default "local"
+        The hydrodynamics: the paper's local slender-body theory, or full slender-body
+        theory (needs ``slenderness``; docs/nonlocal.md).
+    slenderness : float or None, default None
+        With ``model="nonlocal"``: ε = a/L, filament radius over loop length
+        (dimensionless, in (0, 0.05]).
+    max_steps : int, default 2000000
+        Most time steps per case.
+    length_tol : float, default 0.25
+        Relative length error (dimensionless) at which a case stops as failed.
+    steady_interval : float, default 0.5
+        Interval of the steady-state test of the early stop, in t_u.
+    steady_tol : float, default 1e-6
+        Change per interval (dimensionless) below which the state is steady.
+    thresholds : loopsim.outcomes.Thresholds, default Thresholds()
+        The regime, resolution and determinacy thresholds.
+    snapshots_for : sequence of int, default ()
+        Case ids whose trajectories are stored as snapshots.
+    snapshot_count : int, default 101
+        Snapshots per stored trajectory (equally spaced times, both ends included).
+    chunk_size : int or None, default None
+        Cases per result file; None: 32, or 4 with ``n="auto"``.
+    p_halfwidth, tilt_halfwidth, min_seeds, max_seeds, check_seeds : float, int or None, default None
+        With ``seeds="auto"`` only: its targets (a probability; degrees; counts); None:
+        the values of ``loopsim.config.SEED_TARGETS`` (0.15, 2.5, 4, 64, 8).
+    quiet : bool, default True
+        No progress line.
+    threads : int or None, default None
+        Worker threads (None: all cores).
+    scheduler : str or None, default None
+        Address of a Dask scheduler to send the chunks to.
+    local_cluster : bool, default False
+        Start a Dask LocalCluster of ``workers`` processes.
+    workers : int or None, default None
+        Worker processes of the LocalCluster.
+
+    Returns
+    -------
+    pandas.DataFrame
+        One row per case, sorted by ``case_id``: the columns of
+        ``loopsim.columns.RESULT_COLUMNS`` (each with its unit in
+        ``frame.attrs["loopsim"]["columns"]``).
+
+    Raises
+    ------
+    TypeError
+        An unknown keyword argument.
+    ValueError
+        A bad value (named in the message), a seed target without ``seeds="auto"``, or
+        ``out`` holding another sweep.
+    OSError
+        The directory cannot be written.
+    loopsim.sweeps.SweepInterrupted
+        SIGINT or SIGTERM during the sweep (finished cases are kept).
+
+    Examples
+    --------
+    >>> import loopsim
+    >>> rows = loopsim.sweep([10.0, 40.0], 30.0, "runs/two", n=6, t_end=0.5,
+    ...                      twin=False)  # doctest: +SKIP
+    >>> rows[["g0", "regime", "theta_final_deg"]]  # doctest: +SKIP
     """
     auto = isinstance(n, str)
     if auto and n != "auto":
@@ -122,20 +226,24 @@ def sweep(g0, theta0_deg, out, *, n=6, seeds=1, method=None, quiet=True, threads
     seeds_auto = isinstance(seeds, str)
     if seeds_auto and seeds != "auto":
         raise ValueError(f"seeds must be a count or 'auto', got {seeds!r}")
-    targets = {SEED_TARGETS[k][0]: options.pop(k) for k in list(options) if k in SEED_TARGETS}
+    given = dict(p_halfwidth=p_halfwidth, tilt_halfwidth=tilt_halfwidth, min_seeds=min_seeds,
+                 max_seeds=max_seeds, check_seeds=check_seeds)
+    targets = {SEED_TARGETS[k][0]: v for k, v in given.items() if v is not None}
     if targets and not seeds_auto:
         raise ValueError(f"{sorted(targets)} apply only with seeds='auto'")
-    perturbation = options.pop("perturbation", DEFAULT_PERTURBATION)
-    unknown = set(options) - {f.name for f in dataclasses.fields(SweepConfig)} - {"cases"}
-    if unknown or "cases" in options:
-        raise ValueError(f"unknown sweep option(s) {sorted(unknown or {'cases'})}")
     axes = [np.atleast_1d(np.asarray(v, dtype=float)).tolist() for v in (g0, theta0_deg)]
     orders = [DEFAULT_N] if auto else [int(v) for v in np.atleast_1d(n)]
     seeds = 1 if seeds_auto else validation.check_integer("seeds", seeds, 1)
     cases = grid_cases(axes[0], axes[1], orders, seeds, perturbation)
-    options.setdefault("chunk_size", DEFAULT_AUTO_CHUNK_SIZE if auto else DEFAULT_CHUNK_SIZE)
-    config = SweepConfig(cases=cases, method=method or ("auto" if auto else "rkf45"),
-                         n_auto=auto, **options)
+    if chunk_size is None:
+        chunk_size = DEFAULT_AUTO_CHUNK_SIZE if auto else DEFAULT_CHUNK_SIZE
+    config = SweepConfig(
+        cases=cases, method=method or ("auto" if auto else "rkf45"), n_auto=auto,
+        t_end=t_end, rtol=rtol, atol=atol, w=w, twin=twin, early_stop=early_stop,
+        n_max=n_max, tail_tol=tail_tol, model=model, slenderness=slenderness,
+        max_steps=max_steps, length_tol=length_tol, steady_interval=steady_interval,
+        steady_tol=steady_tol, thresholds=thresholds, snapshots_for=list(snapshots_for),
+        snapshot_count=snapshot_count, chunk_size=chunk_size)
     backend = dict(threads=threads, quiet=quiet, command_line=["loopsim.sweep(...)"],
                    scheduler=scheduler, local_cluster=local_cluster, workers=workers)
     if seeds_auto:

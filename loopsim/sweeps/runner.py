@@ -155,8 +155,9 @@ def run_chunk(config, chunk, threads):
                         tail_tol=twin_tail)
         outputs.append((members, x0, method, result, twins))
     wall = time.perf_counter() - start - (_jitcache.compile_seconds() - compiled)
-    total_rhs = sum(int(result[4][:, 2].sum())
-                    + (0 if twins is None else int(twins[4][:, 2].sum()))
+    nfev = integrators.COUNTS.index("nfev")
+    total_rhs = sum(int(result.counts[:, nfev].sum())
+                    + (0 if twins is None else int(twins.counts[:, nfev].sum()))
                     for *_, result, twins in outputs) or 1
     rows = {}
     for members, x0, method, (x_final, _, t_final, status, counts, worst), twins in outputs:
@@ -165,12 +166,12 @@ def run_chunk(config, chunk, threads):
             twin = None
             if twins is not None:
                 twin = dict(outcomes.end_state(
-                    case["theta0_deg"], diagnostics.aspect_ratio(x0[b]), twins[0][b],
-                    int(twins[3][b]) in integrators.SUCCESS, config.thresholds),
-                    nfev=int(twins[4][b, 2]))
+                    case["theta0_deg"], diagnostics.aspect_ratio(x0[b]), twins.x_final[b],
+                    int(twins.status[b]) in integrators.SUCCESS, config.thresholds),
+                    nfev=int(twins.counts[b, nfev]))
             rows[case_id] = _result_row(
                 config, case_id, case, x0[b], x_final[b], int(status[b]),
-                counts[b], worst[b], wall * threads * counts[b, 2] / total_rhs,
+                counts[b], worst[b], wall * threads * counts[b, nfev] / total_rhs,
                 float(t_final[b]), method, twin)
     snapshots = []
     for case_id in traced:

@@ -18,7 +18,7 @@ import os
 import pandas as pd
 import pyarrow as pa
 
-from .. import io, outcomes, seeding, summary, validation
+from .. import columns, io, outcomes, seeding, summary, validation
 from .cases import validate
 
 #: The inputs that tell the cells apart (the seed never does).  Every other input of a
@@ -237,6 +237,7 @@ def stop_table(cells, rows, targets, checks=None):
             verdicts[keys + list(CHECK_COLUMNS.values())], on=keys, how="left")
         table["check_seeds"] = table["check_seeds"].fillna(0).astype("int64")
         table["check_verdict"] = table["check_verdict"].fillna("")
+    table["n"] = table["n"].astype("int64")  # an order (every cell has one): never a float
     return table
 
 
@@ -298,6 +299,7 @@ def run_seeds_auto(config, out, targets, *, run_round, command_line=None, announ
                            expected_costs(cases, rows, twins=False))
     table = stop_table(cells, rows, targets, checks)
     meta = io.provenance(seeds_auto_targets=json.dumps(dataclasses.asdict(targets)))
-    io.write_table_atomically(pa.Table.from_pandas(table, preserve_index=False)
-                              .replace_schema_metadata(meta), os.path.join(out, io.STOPS_FILE))
+    io.write_table_atomically(io.described(pa.Table.from_pandas(table, preserve_index=False)
+                                           .replace_schema_metadata(meta), columns.STOP_COLUMNS),
+                              os.path.join(out, io.STOPS_FILE))
     return io.read_seeds_auto(out), table
