@@ -60,7 +60,8 @@ The steps (the runs), with the figures that need them:
 The figure suite's own runs (all but ``main_job`` and ``seed_cells``) skip the twin
 (``--no-twin``): these figures draw no determinacy, and the twin would cost 1.5-2.5x.
 work_precision (docs/performance.md) runs ``benchmarks/bench_trajectory.py`` itself
-(``WORK_PRECISION``: about 15 minutes on one core).  Fig. 3 and nonlocal_thresholds (the circle's critical q against ε) need no run.  Nothing
+(``WORK_PRECISION``: about 15 minutes on one core); paper_range (docs/distributions.md)
+runs ``scripts/paper_range_study.py``, which also writes its tables into data/.  Fig. 3 and nonlocal_thresholds (the circle's critical q against ε) need no run.  Nothing
 here is random beyond the seeded initial perturbations
 (seed 0 unless stated), so a rerun reproduces the tables.
 
@@ -248,6 +249,7 @@ def targets(quick=False):
         **{f"anim_{step[len('movie_'):]}": ([step], ("animate", step)) for step, *_ in MOVIES},
         "report_main_job": (["main_job"], ("report", "main_job")),
         "work_precision": ([], ("benchmark",)),
+        "paper_range": ([], ("study",)),
         "seed_distributions": (["seeds_n6", "seeds_auto"],
                                ("figures", "seeds_n6", ["seeds_n6", "seeds_auto"], "seeds",
                                 "seed_distributions")),
@@ -330,6 +332,16 @@ def draw(name, how, paths, out, work, quick):
         os.makedirs(work, exist_ok=True)
         os.makedirs(out, exist_ok=True)
         subprocess.run(command, check=True, env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
+    elif kind == "study":
+        runs = os.path.dirname(os.path.dirname(work))  # --runs (work is RUNS/fig/draw)
+        command = [sys.executable, os.path.join(os.path.dirname(__file__),
+                                                "paper_range_study.py"),
+                   "--runs", runs, "--figure", target,
+                   "--data", os.path.join(work, "data") if quick else "data",
+                   *(["--quick"] if quick else [])]
+        print("$ " + " ".join(shlex.quote(a) for a in command), flush=True)
+        os.makedirs(out, exist_ok=True)
+        subprocess.run(command, check=True)
     elif kind == "stability":
         n = 6 if quick else 16
         fig = figures.stability(*figures.stability_data(n=n, n_values=range(3, n + 1)))

@@ -1,0 +1,134 @@
+"""The paper's range as probabilities (docs/distributions.md, "The paper's range as
+probabilities").
+
+Usage: python scripts/paper_range_study.py [--runs runs] [--threads T] [--data data]
+                                           [--figure docs/figures/paper_range.png]
+                                           [--max-seeds 8] [--quick]
+
+The paper's Fig. 5 grid is ``--g0 10:350:15 --theta0 6:90:15`` (225 cells).  This study
+runs, with ``--seeds auto --n auto`` (twins, at most --max-seeds seeds, each sampled
+cell checked in distribution against up to 8 seeds at 10x stricter tolerances):
+
+* ``paper_range_low``: every cell with g0 <= 131.4 (the grid's first six g0 values x
+  its 15 tilts, 90 cells);
+* ``paper_range_band`` and ``paper_range_band18``: the cells with g0 > 150 at θ0 = 6 and
+  12° (18 cells, q0 = 5.4-24.3), and at 18° (9 cells, q0 = 16.0-36.1), the band where the
+  regime can be mixed (the main job's grid found mixed cells only at q0 = 11.7-36.1);
+  two sweeps, because a cell at 18° costs minutes a sample and the rounds of one sweep
+  wait for their slowest cell.
+
+The other 108 cells (g0 > 150, θ0 >= 24°, q0 up to 117) are not run: one of their samples
+costs minutes (docs/distributions.md gives the measured costs and the projection).
+
+Writes ``DATA/paper_range_summary.parquet`` (``loopsim summary`` of both sweeps' rows,
+one row per cell) and ``DATA/paper_range_stops.parquet`` (both stop tables: why each
+cell stopped, and its distribution check), each column described (``loopsim.columns``);
+prints the cost (the runs' ``wall_s`` scaled by (nfev + twin_nfev) / nfev, and the check
+runs') and the cells that are certain, mixed, and those where seed 0's regime is not
+the most probable one; draws the figure (``loopsim summary --figure``'s panels).
+Every sweep resumes: re-run the same command after an interruption.
+"""
+import argparse
+import os
+import sys
+
+import numpy as np
+import pandas as pd
+
+from loopsim import cli, columns, io, summary
+from loopsim.cli.common import print_and_write, save_distribution_figure
+
+#: The paper's grid: g0 = 10..350 in 15 values, θ0 = 6..90° in 15.
+G0 = np.linspace(10.0, 350.0, 15)
+THETA0 = np.linspace(6.0, 90.0, 15)
+#: The two parts run: (name, g0 values, θ0 values).
+PARTS = (("paper_range_low", G0[:6], THETA0), ("paper_range_band", G0[6:], THETA0[:2]),
+         ("paper_range_band18", G0[6:], THETA0[2:3]))
+QUICK_PARTS = (("paper_range_low", G0[:2], THETA0[::7]), ("paper_range_band", G0[6:7],
+                                                            THETA0[:1]))
+
+
+def values(array):
+    return ",".join(repr(float(v)) for v in array)
+
+
+def run_part(path, g0, theta0, threads, max_seeds, quick):
+    """``loopsim sweep --seeds auto`` of one part into ``path`` (resumes)."""
+    args = ["sweep", "--g0", values(g0), "--theta0", values(theta0), "--n", "auto",
+            "--seeds", "auto", "--max-seeds", str(max_seeds), "--threads", str(threads),
+            "--out", path, "--quiet"]
+    if quick:
+        args += ["--t-end", "0.5", "--n-max", "8"]
+    print("$ loopsim " + " ".join(args), flush=True)
+    code = cli.main(args)
+    if code not in (0, 1):
+        sys.exit(f"paper_range_study: the sweep into {path} exited with status {code}")
+
+
+def cost(frame, checks):
+    """(summed seconds of the runs with their twins, of the check runs)."""
+    nfev = frame["nfev"].to_numpy(float).clip(1.0)
+    twin = frame["twin_nfev"].fillna(0.0).to_numpy(float)
+    runs = float((frame["wall_s"].to_numpy(float) * (1.0 + twin / nfev)).sum())
+    return runs, float(checks["wall_s"].sum()) if len(checks) else 0.0
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--runs", default="runs")
+    parser.add_argument("--data", default="data")
+    parser.add_argument("--figure", default=os.path.join("docs", "figures", "paper_range.png"))
+    parser.add_argument("--threads", type=int, default=os.cpu_count() or 1)
+    parser.add_argument("--max-seeds", type=int, default=8)
+    parser.add_argument("--quick", action="store_true",
+                        help="a few cells, t = 0.5, n <= 8: exercises the script")
+    args = parser.parse_args()
+    frames, stops, checks = [], [], []
+    for name, g0, theta0 in QUICK_PARTS if args.quick else PARTS:
+        path = os.path.join(args.runs, name)
+        run_part(path, g0, theta0, args.threads, args.max_seeds, args.quick)
+        frames.append(io.read_seeds_auto(path).assign(part=name))
+        stops.append(io.read_stop_table(path).assign(part=name))
+        check = os.path.join(path, io.CHECK_DIR)
+        if os.path.isdir(check):
+            checks.append(io.read_results(check))
+    frame = pd.concat(frames, ignore_index=True)
+    stop = pd.concat(stops, ignore_index=True).drop(columns="part")
+    stop["n"] = stop["n"].astype("int64")
+    check_rows = pd.concat(checks, ignore_index=True) if checks else pd.DataFrame()
+    table = summary.summarize(frame.drop(columns="part"))
+    os.makedirs(args.data, exist_ok=True)
+    meta = dict(summary_of="paper_range_low + paper_range_band")
+    shown = ["g0", "theta0_deg", "seeds", "determined", "p_stable", "p_in_plane", "p_3d",
+             "tilt_median", "tilt_median_low", "tilt_median_high"]
+    print_and_write(table, os.path.join(args.data, "paper_range_summary.parquet"), meta,
+                    shown, declarations=columns.SUMMARY_COLUMNS)
+    print_and_write(stop, os.path.join(args.data, "paper_range_stops.parquet"), meta,
+                    ["g0", "theta0_deg", "seeds", "stop_reason", "runs", "check_verdict",
+                     "check_tilt_wasserstein"], declarations=columns.STOP_COLUMNS)
+    runs_s, check_s = cost(frame, check_rows)
+    print(f"\ncost: {len(frame)} runs {runs_s:.0f} s with their twins, {len(check_rows)} "
+          f"check runs {check_s:.0f} s; {(runs_s + check_s) / 3600:.2f} h of one core")
+    p = table[["p_stable", "p_in_plane", "p_3d"]].to_numpy(float)
+    certain = (p.max(axis=1) == 1.0)
+    print(f"cells: {len(table)}; certain {int(certain.sum())} (stable "
+          f"{int((table.p_stable == 1).sum())}, in-plane {int((table.p_in_plane == 1).sum())}, "
+          f"3D {int((table.p_3d == 1).sum())}); mixed {int((~certain).sum())}")
+    seed0 = frame[frame["seed"] == 0].set_index(["g0", "theta0_deg"])["regime"]
+    labels = np.array(["stable", "in-plane", "3d"])
+    likeliest = pd.Series(labels[p.argmax(axis=1)],
+                          index=pd.MultiIndex.from_frame(table[["g0", "theta0_deg"]]))
+    misled = [(g, t, seed0[(g, t)], likeliest[(g, t)]) for g, t in likeliest.index
+              if seed0[(g, t)] != likeliest[(g, t)]]
+    print(f"one run (seed 0) misleads (its regime not the most probable) at {len(misled)}:")
+    for g, t, one, most in misled:
+        print(f"  ({g:.1f}, {t:g}°): seed 0 {one}, most probable {most}")
+    print("by regime of the most probable outcome: "
+          + ", ".join(f"{k} {v}" for k, v in likeliest.value_counts().items()))
+    if args.figure:
+        save_distribution_figure(table, frame.drop(columns="part"), args.figure)
+        print(f"figure: {args.figure}")
+
+
+if __name__ == "__main__":
+    main()
