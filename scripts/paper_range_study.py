@@ -26,7 +26,8 @@ cell stopped, and its distribution check), each column described (``loopsim.colu
 prints the cost (the runs' ``wall_s`` scaled by (nfev + twin_nfev) / nfev, and the check
 runs') and the cells that are certain, mixed, and those where seed 0's regime is not
 the most probable one; draws the figure (``loopsim summary --figure``'s panels).
-Every sweep resumes: re-run the same command after an interruption.
+Every sweep resumes: re-run the same command after an interruption.  ``--read-only``
+tabulates the parts that have finished and names the others.
 """
 import argparse
 import os
@@ -41,7 +42,9 @@ from loopsim.cli.common import print_and_write, save_distribution_figure
 #: The paper's grid: g0 = 10..350 in 15 values, θ0 = 6..90° in 15.
 G0 = np.linspace(10.0, 350.0, 15)
 THETA0 = np.linspace(6.0, 90.0, 15)
-#: The two parts run: (name, g0 values, θ0 values).
+#: The figure's resolution: three wide panels under 300 kB.
+FIGURE_DPI = 120
+#: The parts run: (name, g0 values, θ0 values).
 PARTS = (("paper_range_low", G0[:6], THETA0), ("paper_range_band", G0[6:], THETA0[:2]),
          ("paper_range_band18", G0[6:], THETA0[2:3]))
 QUICK_PARTS = (("paper_range_low", G0[:2], THETA0[::7]), ("paper_range_band", G0[6:7],
@@ -80,13 +83,20 @@ def main():
     parser.add_argument("--figure", default=os.path.join("docs", "figures", "paper_range.png"))
     parser.add_argument("--threads", type=int, default=os.cpu_count() or 1)
     parser.add_argument("--max-seeds", type=int, default=8)
+    parser.add_argument("--read-only", action="store_true",
+                        help="run nothing: tabulate the parts that have finished (their stop "
+                             "table written) and name the others")
     parser.add_argument("--quick", action="store_true",
                         help="a few cells, t = 0.5, n <= 8: exercises the script")
     args = parser.parse_args()
     frames, stops, checks = [], [], []
     for name, g0, theta0 in QUICK_PARTS if args.quick else PARTS:
         path = os.path.join(args.runs, name)
-        run_part(path, g0, theta0, args.threads, args.max_seeds, args.quick)
+        if not args.read_only:
+            run_part(path, g0, theta0, args.threads, args.max_seeds, args.quick)
+        elif not os.path.isfile(os.path.join(path, io.STOPS_FILE)):
+            print(f"{name}: not finished, left out ({len(g0) * len(theta0)} cells)")
+            continue
         frames.append(io.read_seeds_auto(path).assign(part=name))
         stops.append(io.read_stop_table(path).assign(part=name))
         check = os.path.join(path, io.CHECK_DIR)
@@ -98,7 +108,7 @@ def main():
     check_rows = pd.concat(checks, ignore_index=True) if checks else pd.DataFrame()
     table = summary.summarize(frame.drop(columns="part"))
     os.makedirs(args.data, exist_ok=True)
-    meta = dict(summary_of="paper_range_low + paper_range_band")
+    meta = dict(summary_of=" + ".join(sorted(set(frame["part"]))))
     shown = ["g0", "theta0_deg", "seeds", "determined", "p_stable", "p_in_plane", "p_3d",
              "tilt_median", "tilt_median_low", "tilt_median_high"]
     print_and_write(table, os.path.join(args.data, "paper_range_summary.parquet"), meta,
@@ -126,7 +136,7 @@ def main():
     print("by regime of the most probable outcome: "
           + ", ".join(f"{k} {v}" for k, v in likeliest.value_counts().items()))
     if args.figure:
-        save_distribution_figure(table, frame.drop(columns="part"), args.figure)
+        save_distribution_figure(table, frame.drop(columns="part"), args.figure, dpi=FIGURE_DPI)
         print(f"figure: {args.figure}")
 
 

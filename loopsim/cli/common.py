@@ -207,7 +207,7 @@ def steady_branch_to(q_max):
     return load_branch(12, q_max=q_max)[0]
 
 
-def save_distribution_figure(table, frame, path):
+def save_distribution_figure(table, frame, path, dpi=150):
     """Draw a summary table and its rows (``figures.distribution_summary``) to ``path``:
     for the local model over its steady branch up to the largest terminal q seen,
     rounded up to a multiple of 5 (at most :data:`BRANCH_Q_MAX`)."""
@@ -220,4 +220,4 @@ def save_distribution_figure(table, frame, path):
     if figures.frame_model(frame).name == "local" and q_seen:
         branch = steady_branch_to(min(BRANCH_Q_MAX, 5.0 * math.ceil(1.05 * max(q_seen) / 5.0)
                                       or 5.0))
-    figures.save(figures.distribution_summary(table, frame, branch=branch), path, dpi=150)
+    figures.save(figures.distribution_summary(table, frame, branch=branch), path, dpi=dpi)
