@@ -311,8 +311,8 @@ def _interrupt_after(monkeypatch, cases):
     """SIGINT to this process, from the sweep's own thread, once ``cases`` cases are done."""
     real = sweeps.Progress.update
 
-    def update(self, case_ids, failures):
-        real(self, case_ids, failures)
+    def update(self, case_ids, failures, seconds=None):
+        real(self, case_ids, failures, seconds)
         if self.done == cases:
             os.kill(os.getpid(), signal.SIGINT)
 

@@ -3,7 +3,7 @@ LocalCluster started here)."""
 import re
 
 from .directory import write_piece
-from .progress import failures
+from .progress import case_seconds, failures
 from .runner import run_piece
 
 
@@ -66,7 +66,8 @@ def run_dask(config, out, fingerprint, pieces, threads, progress, stop, client, 
                 piece, table, snapshots = future.result()
                 if write == "client":
                     write_piece(out, fingerprint, piece, table, snapshots)
-                progress.update(table.column("case_id").to_pylist(), failures(table))
+                progress.update(table.column("case_id").to_pylist(), failures(table),
+                                case_seconds(table))
     finally:
         if pending:
             client.cancel(list(pending))

@@ -7,7 +7,7 @@ import pyarrow as pa
 
 from .._blas import one_blas_thread
 from .directory import write_piece
-from .progress import failures
+from .progress import case_seconds, failures
 from .chunks import chunk_case_ids
 from .runner import run_chunk
 
@@ -81,7 +81,8 @@ def run_local(config, out, fingerprint, pieces, threads, unit, progress, stop, w
 
     def collect(index, part, output):
         finished.setdefault(index, {})[part.start] = (part,) + tuple(output)
-        progress.update(output[0].column("case_id").to_pylist(), failures(output[0]))
+        progress.update(output[0].column("case_id").to_pylist(), failures(output[0]),
+                        case_seconds(output[0]))
         left[index] -= len(part)
         if not left[index]:
             parts = finished.pop(index)
