@@ -100,6 +100,8 @@ def _cell_row(rows, seed):
     trials = len(rows)
     out = dict(seeds=trials, resolved=int(rows["resolved"].sum()),
                determined=int(rows["determined"].eq(True).sum()))
+    if "stop_reason" in rows:
+        out["steady"] = int(rows["stop_reason"].eq("steady").sum())
     for regime in REGIMES:
         name = regime.replace("-", "_")
         hits = int((rows["regime"] == regime).sum())
@@ -145,8 +147,9 @@ def summarize(frame, by=None, seed=0):
         One row per cell, sorted by its inputs, with the columns of
         ``loopsim.columns.SUMMARY_COLUMNS``:
 
-        * ``seeds``, ``resolved``, ``determined``: how many rows, and how many of them
-          are resolved and determined;
+        * ``seeds``, ``resolved``, ``determined``, ``steady``: how many rows, and how
+          many of them are resolved, determined, and reached a steady state before
+          ``t_end`` (the others' "terminal" values are their state at ``t_end``);
         * ``p_<regime>`` for each regime (stable, in_plane, 3d, failed), with its 95 %
           Wilson score interval ``p_<regime>_low``, ``p_<regime>_high``:
           (p̂ + z²/2N ± z sqrt(p̂(1 − p̂)/N + z²/4N²)) / (1 + z²/N), z = Φ⁻¹(0.975);

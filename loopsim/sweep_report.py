@@ -23,7 +23,7 @@ from . import outputs
 
 #: Columns of the per-cell table shown (those present), in order: the cell's inputs
 #: first (``summary.CELL_INPUTS``), then these.
-CELL_COLUMNS = ("seeds", "resolved", "determined", "p_stable", "p_in_plane", "p_3d",
+CELL_COLUMNS = ("seeds", "resolved", "determined", "steady", "p_stable", "p_in_plane", "p_3d",
                 "p_failed", "p_3d_low", "p_3d_high", "tilt_median", "tilt_median_low",
                 "tilt_median_high", "aspect_median", "wall_s")
 #: Costliest cases listed by default; resolution of the embedded figures (``loopsim.outputs``).

@@ -126,15 +126,24 @@ def main():
           f"3D {int((table.p_3d == 1).sum())}); mixed {int((~certain).sum())}")
     seed0 = frame[frame["seed"] == 0].set_index(["g0", "theta0_deg"])["regime"]
     labels = np.array(["stable", "in-plane", "3d"])
-    likeliest = pd.Series(labels[p.argmax(axis=1)],
-                          index=pd.MultiIndex.from_frame(table[["g0", "theta0_deg"]]))
-    misled = [(g, t, seed0[(g, t)], likeliest[(g, t)]) for g, t in likeliest.index
-              if seed0[(g, t)] != likeliest[(g, t)]]
-    print(f"one run (seed 0) misleads (its regime not the most probable) at {len(misled)}:")
+    cells = pd.MultiIndex.from_frame(table[["g0", "theta0_deg"]])
+    likeliest = pd.Series(["/".join(labels[row == row.max()]) for row in p], index=cells)
+    share = pd.DataFrame(p, index=cells, columns=labels)
+    misled = [(g, t, seed0[(g, t)], likeliest[(g, t)]) for g, t in cells
+              if share.loc[(g, t), seed0[(g, t)]] < share.loc[(g, t)].max()]
+    print(f"one run (seed 0) misleads (its regime less probable than another) at "
+          f"{len(misled)}:")
     for g, t, one, most in misled:
         print(f"  ({g:.1f}, {t:g}°): seed 0 {one}, most probable {most}")
-    print("by regime of the most probable outcome: "
+    print("by regime of the most probable outcome (a/b: a tie): "
           + ", ".join(f"{k} {v}" for k, v in likeliest.value_counts().items()))
+    moving = table[table["steady"] < table["seeds"]]
+    print(f"cells with seeds not steady at t_end (their tilt a snapshot): {len(moving)}; "
+          f"runs not steady: {int((table['seeds'] - table['steady']).sum())} of "
+          f"{int(table['seeds'].sum())}")
+    for _, cell in moving.iterrows():
+        print(f"  ({cell['g0']:.1f}, {cell['theta0_deg']:g}°): "
+              f"{int(cell['seeds'] - cell['steady'])} of {int(cell['seeds'])}")
     if args.figure:
         save_distribution_figure(table, frame.drop(columns="part"), args.figure, dpi=FIGURE_DPI)
         print(f"figure: {args.figure}")

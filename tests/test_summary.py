@@ -50,7 +50,8 @@ def test_summarize_groups_seeds_into_cells():
                              resolved=True, determined=seed != 3,
                              theta_final_deg=60.0 if g0 < 100 else 20.0 + seed,
                              aspect_ratio=1.0 + seed / 100, nfev=100, twin_nfev=150,
-                             wall_s=0.5))
+                             wall_s=0.5,
+                             stop_reason="t_end" if (g0 > 100 and seed == 5) else "steady"))
     table = summary.summarize(pd.DataFrame(rows))
     assert list(table["g0"]) == [30.0, 150.0] and "n" not in table and "seed" not in table
     stable, hot = table.iloc[0], table.iloc[1]
@@ -60,6 +61,7 @@ def test_summarize_groups_seeds_into_cells():
     assert hot["tilt_median"] == 23.5 and hot["tilt_q25"] == 21.75
     assert hot["tilt_median_low"] <= 23.5 <= hot["tilt_median_high"]
     assert hot["nfev"] == 800 and hot["wall_s"] == 4.0
+    assert stable["steady"] == 8 and hot["steady"] == 7  # seed 5 still moving at t_end
     with pytest.raises(ValueError, match="no column"):
         summary.summarize(pd.DataFrame(rows), by=["colour"])
 
@@ -144,10 +146,18 @@ def test_summary_figures_draw_every_cell():
                                  q0=g0 * np.sin(np.radians(theta)) / 3,
                                  theta_final_deg=theta - (10 + seed if g0 > 100 else 0),
                                  aspect_ratio=1.5 + 0.1 * seed, nfev=1, twin_nfev=1,
-                                 wall_s=0.1, q_final=g0 / 10 + seed))
+                                 wall_s=0.1, q_final=g0 / 10 + seed,
+                                 stop_reason="t_end" if (g0 > 100 and seed == 1) else "steady"))
     frame = pd.DataFrame(rows)
     cells = summary.summarize(frame)
     fig = figures.probability_phase_diagram(cells, style="colour")
+    marks = [c for c in fig.axes[0].collections
+             if c.get_label() == "some seeds not steady at t_end"]
+    assert len(marks) == 1 and len(marks[0].get_offsets()) == 2  # the two cells at g0 = 150
+    no_early_stop = summary.summarize(frame.assign(stop_reason="t_end"))
+    fig = figures.probability_phase_diagram(no_early_stop, style="colour")
+    assert not [c for c in fig.axes[0].collections
+                if c.get_label() == "some seeds not steady at t_end"]  # no run was tested
     colours = fig.axes[0].collections[0]
     assert len(colours.get_offsets()) == 4
     np.testing.assert_allclose(colours.get_array(), cells["p_3d"])
@@ -156,7 +166,7 @@ def test_summary_figures_draw_every_cell():
     assert sorted(t.get_text() for t in fig.axes[0].texts) == ["0.25", "0.25"]
     # as pies: one wedge per regime a cell reaches, clockwise from the top, filling it
     fig = figures.probability_phase_diagram(cells)
-    wedges = [c for c in fig.axes[0].collections if c.get_label() != "some seeds not determined"
+    wedges = [c for c in fig.axes[0].collections if not c.get_label().startswith("some seeds")
               and len(c.get_offsets()) == 1]
     assert len(wedges) == 1 + 1 + 2 + 2
     assert sorted(c.get_label() for c in fig.axes[0].collections

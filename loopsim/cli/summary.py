@@ -11,7 +11,8 @@ def add_parser(commands):
         "summary", help="one row per cell of a sweep: regime probabilities, tilt and aspect "
         "ratio medians, with 95%% intervals",
         description="Summarise a sweep over its seeds: per cell (g0, theta0 and every other "
-        "swept input), the number of seeds, resolved and determined rows, each regime's "
+        "swept input), the number of seeds, resolved, determined and steady rows (steady: "
+        "a terminal state reached before --t-end), each regime's "
         "probability with its Wilson interval, the median and quartiles of the terminal "
         "tilt and aspect ratio with bootstrap intervals of the medians, and the cost "
         "(loopsim/summary.py).",
@@ -42,7 +43,7 @@ def command(args):
         figures.frame_model(frame)
         figures.check_one_cell_per_point(table)
     shown = [c for c in table.columns if c in summary.CELL_INPUTS] + [
-        "seeds", "determined", "p_stable", "p_in_plane", "p_3d", "p_3d_low", "p_3d_high",
+        "seeds", "determined", "steady", "p_stable", "p_in_plane", "p_3d", "p_3d_low", "p_3d_high",
         "tilt_median", "tilt_median_low", "tilt_median_high"]
     print_and_write(table, args.out, dict(table.attrs["loopsim_summary"],
                                            summary_of=directory_name(args.sweep_dir)),

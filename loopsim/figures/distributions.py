@@ -62,8 +62,10 @@ def probability_phase_diagram(cells, frame=None, ax=None, style="pie"):
     (``loopsim.summarize``) at (θ0, g0) as a pie of its regime probabilities
     (``style="pie"``, :func:`regime_pies`) or coloured by its probability of ending 3D
     (``style="colour"``, labelled with P(in-plane) when it is neither 0 nor 1); ringed
-    red where any seed is not determined; with the full linearisation's thresholds
-    (``q_c`` at n = 16)."""
+    red where any seed is not determined, marked by a black triangle where any seed had
+    not reached a steady state at ``t_end`` (its tilt is then a snapshot: only when some
+    run of the table did stop early, so not for ``--no-early-stop``); with the full
+    linearisation's thresholds (``q_c`` at n = 16)."""
     if style not in ("pie", "colour"):
         raise ValueError(f"style must be 'pie' or 'colour', got {style!r}")
     check_one_cell_per_point(cells)
@@ -83,6 +85,12 @@ def probability_phase_diagram(cells, frame=None, ax=None, style="pie"):
         ax.scatter(mixed["theta0_deg"], mixed["g0"], s=230 if style == "pie" else 150,
                    facecolors="none", edgecolors="#d62728", linewidths=0.9, zorder=4,
                    label="some seeds not determined")
+    if "steady" in cells and cells["steady"].sum() > 0:
+        unsteady = cells[cells["steady"] < cells["seeds"]]
+        if len(unsteady):
+            ax.scatter(unsteady["theta0_deg"] + 2.2, unsteady["g0"] + 0.035 * cells["g0"].max(),
+                       marker="v", s=14, color="k", zorder=5,
+                       label="some seeds not steady at t_end")
     theta = np.linspace(1.0, 90.0, 300)
     for sector, line in (("in-plane", "--"), ("out-of-plane", ":")):
         q_sector = circle.critical_q(16, sector)
