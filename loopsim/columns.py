@@ -117,8 +117,8 @@ SUMMARY_COLUMNS = {
     "resolved": (COUNT, "rows of the cell whose n_used resolves them"),
     "determined": (COUNT, "rows of the cell whose outcome is determined (a twin agreed)"),
     "steady": (COUNT, "rows of the cell that reached a steady state before t_end (stop_reason "
-                      "steady); the others' terminal values are their state at t_end (0 with "
-                      "--no-early-stop, which tests no run)"),
+                      "steady); the others ran to t_end, their terminal values the state there, or "
+                      "failed (0 with --no-early-stop, which tests no run)"),
     **{f"p_{regime}{end}": (PROBABILITY, f"{what} of the regime {label}")
        for regime, label in (("stable", "stable"), ("in_plane", "in-plane"), ("3d", "3d"),
                              ("failed", "failed"))

@@ -149,7 +149,8 @@ def summarize(frame, by=None, seed=0):
 
         * ``seeds``, ``resolved``, ``determined``, ``steady``: how many rows, and how
           many of them are resolved, determined, and reached a steady state before
-          ``t_end`` (the others' "terminal" values are their state at ``t_end``);
+          ``t_end`` (the others ran to ``t_end``, their "terminal" values the state
+          there, or failed; ``steady`` only where ``frame`` has ``stop_reason``);
         * ``p_<regime>`` for each regime (stable, in_plane, 3d, failed), with its 95 %
           Wilson score interval ``p_<regime>_low``, ``p_<regime>_high``:
           (p̂ + z²/2N ± z sqrt(p̂(1 − p̂)/N + z²/4N²)) / (1 + z²/N), z = Φ⁻¹(0.975);

@@ -14,14 +14,16 @@ cell checked in distribution against up to 8 seeds at 10x stricter tolerances):
 * ``paper_range_band`` and ``paper_range_band18``: the cells with g0 > 150 at θ0 = 6 and
   12° (18 cells, q0 = 5.4-24.3), and at 18° (9 cells, q0 = 16.0-36.1), the band where the
   regime can be mixed (the main job's grid found mixed cells only at q0 = 11.7-36.1);
-  two sweeps, because a cell at 18° costs minutes a sample and the rounds of one sweep
-  wait for their slowest cell.
+  two sweeps, because a cell at 18° costs minutes a sample above g0 = 250 and the rounds
+  of one sweep wait for their slowest cell;
+* ``paper_range_band24`` and ``paper_range_mid30``: g0 = 155.7-228.6 at θ0 = 24° (4
+  cells) and at 30° and 36° (8 cells), whose samples cost seconds.
 
-The other 108 cells (g0 > 150, θ0 >= 24°, q0 up to 117) are not run: one of their samples
+The other cells (g0 > 150 and θ0 >= 24°, except those) are not run: one of their samples
 costs minutes (docs/distributions.md gives the measured costs and the projection).
 
-Writes ``DATA/paper_range_summary.parquet`` (``loopsim summary`` of both sweeps' rows,
-one row per cell) and ``DATA/paper_range_stops.parquet`` (both stop tables: why each
+Writes ``DATA/paper_range_summary.parquet`` (``loopsim summary`` of every part's rows,
+one row per cell) and ``DATA/paper_range_stops.parquet`` (their stop tables: why each
 cell stopped, and its distribution check), each column described (``loopsim.columns``);
 prints the cost (the runs' ``wall_s`` scaled by (nfev + twin_nfev) / nfev, and the check
 runs') and the cells that are certain, mixed, and those where seed 0's regime is not
@@ -46,7 +48,9 @@ THETA0 = np.linspace(6.0, 90.0, 15)
 FIGURE_DPI = 120
 #: The parts run: (name, g0 values, θ0 values).
 PARTS = (("paper_range_low", G0[:6], THETA0), ("paper_range_band", G0[6:], THETA0[:2]),
-         ("paper_range_band18", G0[6:], THETA0[2:3]))
+         ("paper_range_band18", G0[6:], THETA0[2:3]),
+         ("paper_range_band24", G0[6:10], THETA0[3:4]),
+         ("paper_range_mid30", G0[6:10], THETA0[4:6]))
 QUICK_PARTS = (("paper_range_low", G0[:2], THETA0[::7]), ("paper_range_band", G0[6:7],
                                                             THETA0[:1]))
 
@@ -125,10 +129,12 @@ def main():
           f"{int((table.p_stable == 1).sum())}, in-plane {int((table.p_in_plane == 1).sum())}, "
           f"3D {int((table.p_3d == 1).sum())}); mixed {int((~certain).sum())}")
     seed0 = frame[frame["seed"] == 0].set_index(["g0", "theta0_deg"])["regime"]
-    labels = np.array(["stable", "in-plane", "3d"])
+    labels = np.array(["stable", "in-plane", "3d", "failed"])
     cells = pd.MultiIndex.from_frame(table[["g0", "theta0_deg"]])
-    likeliest = pd.Series(["/".join(labels[row == row.max()]) for row in p], index=cells)
-    share = pd.DataFrame(p, index=cells, columns=labels)
+    share = pd.DataFrame(table[["p_stable", "p_in_plane", "p_3d", "p_failed"]].to_numpy(float),
+                         index=cells, columns=labels)
+    likeliest = pd.Series(["/".join(labels[row == row.max()]) for row in share.to_numpy()],
+                          index=cells)
     misled = [(g, t, seed0[(g, t)], likeliest[(g, t)]) for g, t in cells
               if share.loc[(g, t), seed0[(g, t)]] < share.loc[(g, t)].max()]
     print(f"one run (seed 0) misleads (its regime less probable than another) at "

@@ -43,7 +43,8 @@ def command(args):
         figures.frame_model(frame)
         figures.check_one_cell_per_point(table)
     shown = [c for c in table.columns if c in summary.CELL_INPUTS] + [
-        "seeds", "determined", "steady", "p_stable", "p_in_plane", "p_3d", "p_3d_low", "p_3d_high",
+        c for c in ("seeds", "determined", "steady") if c in table] + [
+        "p_stable", "p_in_plane", "p_3d", "p_3d_low", "p_3d_high",
         "tilt_median", "tilt_median_low", "tilt_median_high"]
     print_and_write(table, args.out, dict(table.attrs["loopsim_summary"],
                                            summary_of=directory_name(args.sweep_dir)),
