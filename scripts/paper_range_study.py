@@ -16,9 +16,10 @@ cell checked in distribution against up to 8 seeds at 10x stricter tolerances):
   regime can be mixed (the main job's grid found mixed cells only at q0 = 11.7-36.1);
   two sweeps, because a cell at 18° costs minutes a sample above g0 = 250 and the rounds
   of one sweep wait for their slowest cell;
-* ``paper_range_band24``, ``paper_range_mid30`` and ``paper_range_mid42``: g0 =
-  155.7-228.6 at θ0 = 24° (4 cells), 30° and 36°, 42° and 48° (8 cells each), whose
-  samples cost seconds (0.2-68 s on average per cell).
+* ``paper_range_band24``, ``paper_range_mid30``, ``paper_range_mid42`` and
+  ``paper_range_mid54``: g0 = 155.7-228.6 at θ0 = 24° (4 cells), 30° and 36°, 42° and
+  48°, 54° and 60° (8 cells each), whose samples cost seconds (0.2-68 s on average per
+  cell).
 
 The other cells (g0 > 150 and θ0 >= 24°, except those) are not run: one of their samples
 costs minutes (docs/distributions.md gives the measured costs and the projection).
@@ -52,7 +53,8 @@ PARTS = (("paper_range_low", G0[:6], THETA0), ("paper_range_band", G0[6:], THETA
          ("paper_range_band18", G0[6:], THETA0[2:3]),
          ("paper_range_band24", G0[6:10], THETA0[3:4]),
          ("paper_range_mid30", G0[6:10], THETA0[4:6]),
-         ("paper_range_mid42", G0[6:10], THETA0[6:8]))
+         ("paper_range_mid42", G0[6:10], THETA0[6:8]),
+         ("paper_range_mid54", G0[6:10], THETA0[8:10]))
 QUICK_PARTS = (("paper_range_low", G0[:2], THETA0[::7]), ("paper_range_band", G0[6:7],
                                                             THETA0[:1]))
 
