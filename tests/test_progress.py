@@ -79,3 +79,25 @@ def test_the_line_shows_the_upper_end_once_cases_are_timed(monkeypatch):
         text.replace("h", " ").replace("m", " ").replace("s", " ").split()[:3],
         (3600, 60, 1))) for text in (eta, upper)]
     assert seconds[1] > seconds[0]
+
+
+def _upper_seconds(line):
+    text = line.split("(90%: <")[1].split(")")[0]
+    h, rest = text.split("h")
+    m, s = rest.rstrip("s").split("m")
+    return 3600 * int(h) + 60 * int(m) + int(s)
+
+
+def test_the_upper_end_is_aged_between_estimates(monkeypatch):
+    clock = [0.0]
+    monkeypatch.setattr(time, "perf_counter", lambda: clock[0])
+    stream = stdio.StringIO()
+    line = progress.Progress({i: 1.0 for i in range(20)}, [], stream=stream, interval=0.0)
+    for i, seconds in enumerate([1.0, 1.0, 1.0, 1.0, 100.0]):
+        clock[0] = 10.0 * (i + 1)
+        line.update([i], 0, [seconds])  # t = 10 ... 50: the estimate made at t = 50
+    first = _upper_seconds(stream.getvalue().splitlines()[-1])
+    clock[0] = 52.0
+    line.update([5], 0, [1.0])  # within ETA_UPPER_EVERY: the estimate, 2 s older
+    second = _upper_seconds(stream.getvalue().splitlines()[-1])
+    assert first > 100 and second == first - 2
