@@ -20,8 +20,7 @@ cell checked in distribution against up to 8 seeds at 10x stricter tolerances):
   ``paper_range_mid54``: g0 = 155.7-228.6 at θ0 = 24° (4 cells), 30° and 36°, 42° and
   48°, 54° and 60° (8 cells each), whose samples cost seconds (0.2-68 s on average per
   cell);
-* ``paper_range_mid66``: g0 = 155.7-228.6 at 66° and 72° (8 cells), started and not
-  yet finished, so not yet in the committed tables (``--read-only`` leaves it out).
+* ``paper_range_mid66``: g0 = 155.7-228.6 at 66° and 72° (8 cells).
 
 The other cells (g0 > 150 and θ0 >= 24°, except those) are not run: one of their samples
 costs minutes (docs/distributions.md gives the measured costs and the projection).
