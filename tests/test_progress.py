@@ -22,13 +22,11 @@ def test_equal_paces_give_the_mean_rate_eta():
 def test_a_heavy_tail_lifts_the_upper_end_to_the_tail():
     # 6 of 8 finished cases took 1 s, 2 took 250 s (weights equal): a remaining case draws
     # 250 s with probability 1/4 > 1 - 0.9, so the 90% quantile is the tail's 250 s
-    # (it runs alone: the straggler term), while the mean-rate ETA, working x (weight
-    # left) / (weight done), says 253 s x 1/8 = 31.6 s
+    # (it runs alone: the straggler term), where the mean-rate ETA, working x (weight
+    # left) / (weight done) = 253 s x 1/8, says 31.6 s
     seconds = [1.0] * 6 + [250.0] * 2
-    working = sum(seconds) / 2
-    upper = progress.eta_upper([1.0] * 8, seconds, [1.0], working=working)
+    upper = progress.eta_upper([1.0] * 8, seconds, [1.0], working=sum(seconds) / 2)
     assert upper == pytest.approx(250.0, rel=1e-12)
-    assert working * 1.0 / 8.0 == pytest.approx(31.625) and upper > 7 * working / 8
 
 
 def test_the_costliest_remaining_case_bounds_it_from_below():
