@@ -1,0 +1,178 @@
+"""Convergence in distribution at the top of the paper's range (docs/distributions.md,
+"Convergence in distribution at the top of the range").
+
+Usage: python scripts/convergence_study.py [--runs runs/convergence] [--threads T]
+                                           [--loopsim loopsim] [--out data/convergence_top.parquet]
+                                           [--read-only]
+
+Per cell, 16 seeds (0-15) at each of four settings, all without twins (a cell there is
+a distribution, not an outcome):
+
+* ``default``:  ``--n auto`` (radau5, rtol 1e-6, atol 1e-9, n up to 32);
+* ``rtol1e-8``: the same at ``--rtol 1e-8 --atol 1e-11``;
+* ``n40``:      ``--n 40 --method radau5`` (rtol 1e-6);
+* ``amp1e-4``:  ``--n auto --perturbation 1e-4`` (three cells).
+
+The ensemble is loopsim's seeded perturbation (``loopsim.shapes.circle``): RMS size 1e-3
+(1e-4 for ``amp1e-4``) in modes 2 to the starting order with amplitudes drawn as N(0, 1)/k²,
+the loop rescaled to length 2π; the starting order is 6 with ``--n auto`` (modes 2-6,
+zero-padded when the ladder climbs) and 40 with ``--n 40`` (modes 7-40 then carry 1.7 %
+of the perturbation's variance).
+
+Each setting is one ``loopsim sweep`` per group of cells, run by the ``--loopsim``
+executable (a frozen install keeps a study on one version of the code: the sweeps record
+their configuration, not the code), in the order below, each resumable; ``--read-only``
+tabulates the sweeps that have finished.  The table (one row per cell and setting;
+columns in COLUMNS below) compares every setting with ``default`` through
+``loopsim.distribution_differences``: differences of the regime probabilities, of
+P(steady before t_end) and of the tilt quartiles, with 95 % intervals, the smallest
+difference each comparison could have detected, and a verdict.
+"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pandas as pd
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+import loopsim
+from loopsim import distribution_differences as dd
+from loopsim import summary
+
+G0 = np.linspace(10.0, 350.0, 15)  # the paper's grid
+G12 = ",".join(repr(float(v)) for v in G0[10:])  # 252.9 ... 350
+SEEDS = 16
+SETTINGS = {
+    "default": ["--n", "auto"],
+    "rtol1e-8": ["--n", "auto", "--rtol", "1e-8", "--atol", "1e-11"],
+    "n40": ["--n", "40", "--method", "radau5"],
+    "amp1e-4": ["--n", "auto", "--perturbation", "1e-4"],
+}
+#: (sweep name, setting, g0 values, θ0) in the order they run.
+SWEEPS = (
+    ("default_t12", "default", G12, "12"),
+    ("default_t60", "default", repr(float(G0[9])), "60"),
+    ("rtol1e-8_t12", "rtol1e-8", G12, "12"),
+    ("rtol1e-8_t60", "rtol1e-8", repr(float(G0[9])), "60"),
+    ("amp1e-4_t12", "amp1e-4", f"{G0[12]!r},{G0[14]!r}", "12"),
+    ("amp1e-4_t60", "amp1e-4", repr(float(G0[9])), "60"),
+    ("n40_t12", "n40", G12, "12"),
+    ("n40_t60", "n40", repr(float(G0[9])), "60"),
+    ("default_t18", "default", f"{G0[14]!r},{G0[13]!r}", "18"),
+    ("rtol1e-8_t18", "rtol1e-8", f"{G0[14]!r},{G0[13]!r}", "18"),
+    ("n40_t18", "n40", f"{G0[14]!r},{G0[13]!r}", "18"),
+)
+ENSEMBLE = ("loopsim's seeded perturbation (loopsim.shapes.circle): seeds 0-15, RMS size "
+            "1e-3 (1e-4 for amp1e-4) in modes 2 to the starting order (6 with --n auto, "
+            "zero-padded as n climbs; 40 with --n 40), amplitudes N(0,1)/k^2")
+REGIMES = ("stable", "in-plane", "3d")
+
+
+def sweep_command(loopsim_exe, runs, name, setting, g0, theta0, threads):
+    return [loopsim_exe, "sweep", "--g0", g0, "--theta0", theta0, "--seeds", str(SEEDS),
+            "--no-twin", *SETTINGS[setting], "--threads", str(threads),
+            "--out", os.path.join(runs, name), "--progress-every", "120"]
+
+
+def cell_rows(frame):
+    """Per-row outcome indicators: is_<regime> and steady (empty where untested)."""
+    out = frame.assign(**{f"is_{r.replace('-', '_')}": frame["regime"].eq(r) for r in REGIMES})
+    out["steady"] = frame["stop_reason"].eq("steady").astype("boolean")
+    out.loc[frame["stop_reason"].isna(), "steady"] = pd.NA
+    return out
+
+
+def describe(rows):
+    """Per-cell statistics of one setting."""
+    out = dict(seeds=len(rows), failed=int(rows["regime"].eq("failed").sum()))
+    for name in [f"is_{r.replace('-', '_')}" for r in REGIMES] + ["steady"]:
+        values = rows[name].dropna().astype(bool)
+        hits = int(values.sum())
+        out[f"p_{name[3:] if name.startswith('is_') else name}"] = hits / max(len(values), 1)
+        low, high = summary.wilson_interval(hits, len(values))
+        key = name[3:] if name.startswith("is_") else name
+        out[f"p_{key}_low"], out[f"p_{key}_high"] = low, high
+    certain = [r for r in REGIMES if dd.certain(int(rows["regime"].eq(r).sum()), len(rows))]
+    out["certain_regime"] = certain[0] if certain else None
+    tilt = rows["theta_final_deg"].to_numpy(float)
+    out["tilt_q25"], out["tilt_q50"], out["tilt_q75"] = np.nanpercentile(tilt, [25, 50, 75])
+    out["tilt_q50_low"], out["tilt_q50_high"] = summary.bootstrap_interval(tilt)
+    out["nfev_mean"] = float(rows["nfev"].mean())
+    out["wall_s"] = float(rows["wall_s"].sum())
+    return out
+
+
+def tabulate(frames):
+    """One row per cell and setting; the comparisons with ``default``."""
+    table = []
+    default = frames.get("default")
+    for setting, frame in frames.items():
+        for (g0, theta0), rows in frame.groupby(["g0", "theta0_deg"]):
+            row = dict(g0=g0, theta0_deg=theta0, q0=g0 * np.sin(np.radians(theta0)) / 3,
+                       setting=setting, **describe(rows))
+            if setting != "default" and default is not None:
+                base = default[(default["g0"] == g0) & (default["theta0_deg"] == theta0)]
+                if len(base):
+                    row.update(dd.compare_samples(base, rows, ["is_in_plane", "is_3d",
+                                                               "steady"]))
+            table.append(row)
+    return pd.DataFrame(table).sort_values(["theta0_deg", "g0", "setting"], ignore_index=True)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--runs", default=os.path.join("runs", "convergence"))
+    parser.add_argument("--threads", type=int, default=os.cpu_count() or 1)
+    parser.add_argument("--loopsim", default="loopsim", help="the loopsim executable that runs "
+                        "the sweeps (a frozen install keeps the study on one code version)")
+    parser.add_argument("--out", default=os.path.join("data", "convergence_top.parquet"))
+    parser.add_argument("--read-only", action="store_true",
+                        help="run nothing: tabulate the sweeps that have finished")
+    args = parser.parse_args()
+    frames, finished = {}, []
+    for name, setting, g0, theta0 in SWEEPS:
+        path = os.path.join(args.runs, name)
+        if not args.read_only:
+            command = sweep_command(args.loopsim, args.runs, name, setting, g0, theta0,
+                                    args.threads)
+            print("$ " + " ".join(command), flush=True)
+            if subprocess.call(command) not in (0, 1):
+                sys.exit(f"convergence_study: the sweep into {path} did not finish")
+        try:
+            frame = loopsim.read_results(path)
+        except (FileNotFoundError, ValueError):
+            print(f"{name}: not finished, left out")
+            continue
+        if len(frame) < SEEDS * len(g0.split(",")):
+            print(f"{name}: {len(frame)} of {SEEDS * len(g0.split(','))} cases, left out")
+            continue
+        finished.append(name)
+        frames[setting] = pd.concat([frames.get(setting), cell_rows(frame)], ignore_index=True)
+    if not frames:
+        sys.exit("convergence_study: no sweep has finished")
+    table = tabulate(frames)
+    meta = dict(ensemble=ENSEMBLE, seeds=f"0-{SEEDS - 1}", sweeps=finished,
+                settings={k: " ".join(v) for k, v in SETTINGS.items()},
+                intervals="95% Wilson (p), Newcombe hybrid score (p differences), percentile "
+                          "bootstrap (quantiles); verdict with Bonferroni intervals",
+                certain=f"95% Wilson lower end >= {dd.CERTAIN_LOWER}",
+                power_of_detectable=dd.POWER, loopsim_version=loopsim.__version__)
+    arrow = pa.Table.from_pandas(table, preserve_index=False)
+    arrow = arrow.replace_schema_metadata({**(arrow.schema.metadata or {}),
+                                           b"loopsim_convergence": json.dumps(meta).encode()})
+    os.makedirs(os.path.dirname(args.out) or ".", exist_ok=True)
+    temporary = args.out + ".tmp"
+    pq.write_table(arrow, temporary)
+    os.replace(temporary, args.out)
+    with pd.option_context("display.width", 200, "display.max_columns", 30):
+        print(table[["g0", "theta0_deg", "setting", "seeds", "p_3d", "p_steady", "tilt_q50",
+                     "certain_regime"] + [c for c in ("verdict",) if c in table]].to_string())
+    print(f"wrote {args.out}")
+
+
+if __name__ == "__main__":
+    main()
