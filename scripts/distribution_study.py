@@ -30,6 +30,7 @@ import os
 import time
 
 import pandas as pd
+import pyarrow as pa
 
 import loopsim
 from loopsim import columns, config, io, refinement, shapes, spectral, sweeps
@@ -79,7 +80,7 @@ def resolution_check(cells, args, directory):
     for cell in cells:
         path = os.path.join(directory, f"g{cell['g0']:g}_t{cell['theta0_deg']:g}.parquet")
         if os.path.exists(path):
-            frames.append(pd.read_parquet(path))
+            frames.append(io.read_table_checked(path).to_pandas())  # damaged: named
         else:
             todo.append((cell, path))
     context = multiprocessing.get_context("spawn")  # no fork of a process that ran prange
@@ -90,8 +91,7 @@ def resolution_check(cells, args, directory):
                 (cell["g0"], cell["theta0_deg"], seed, args.check_n)
                 for seed in range(args.check_seeds)])))
             frame = pd.DataFrame(rows)
-            frame.to_parquet(path + ".part", index=False)
-            os.replace(path + ".part", path)
+            io.write_table_atomically(pa.Table.from_pandas(frame, preserve_index=False), path)
             print(f"{args.check} check: g0 = {cell['g0']:g}, theta0 = {cell['theta0_deg']:g}: "
                   f"{frame['wall_s'].sum():.0f} s summed", flush=True)
             frames.append(frame)

@@ -260,6 +260,35 @@ def test_damaged_chunk_as_initial_is_refused(sweep, capsys):
     assert "damaged" in capsys.readouterr().err
 
 
+def test_damaged_run_file_is_refused_by_animate_and_figures(sweep, tmp_path, capsys):
+    """Issue 46.1: a flipped bit in a run file's coefficients used to be drawn with exit 0;
+    ``animate`` and ``figures`` read run files checked, as sweep chunks are read."""
+    run = str(tmp_path / "run.parquet")
+    assert main(["run", "--g0", "60", "--theta0", "30", "--n", "4", "--t-end", "0.05",
+                 "--snapshots", "5", "--no-twin", "--out", run]) == 0
+    capsys.readouterr()
+    _silent_flip(run, "x")
+    gif, figs = tmp_path / "a.gif", tmp_path / "figs"
+    for argv in (["animate", run, "--out", str(gif)],
+                 ["figures", sweep, run, "--out", str(figs), "--only", "evolution"]):
+        assert main(argv) == 2, argv
+        err = capsys.readouterr().err
+        assert len(err.splitlines()) == 1 and "damaged" in err and run in err, err
+    assert not gif.exists() and not figs.exists()
+
+
+def test_damaged_parquet_cases_file_is_refused(tmp_path, capsys):
+    """Issue 46.1: a cases file loopsim wrote (with checksums) is read checked too."""
+    path = str(tmp_path / "cases.parquet")
+    io.write_table_atomically(pa.table({"g0": np.linspace(10.0, 60.0, 50),
+                                        "theta0_deg": np.full(50, 30.0)}), path)
+    _silent_flip(path, "g0")
+    assert main(["sweep", "--n", "4", "--cases", path, "--out", str(tmp_path / "s")]) == 2
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1 and "damaged" in err and path in err, err
+    assert not (tmp_path / "s").exists()
+
+
 # ---- sizes and inputs bounded before any work --------------------------------------------
 def _point_file(path, rows):
     s = np.linspace(0.0, 2 * np.pi, rows, endpoint=False)

@@ -9,7 +9,7 @@ import re
 import numpy as np
 import pandas as pd
 
-from .. import integrators, models, refinement, shapes, validation
+from .. import integrators, io, models, refinement, shapes, validation
 from ..config import (
     DEFAULT_ATOL, DEFAULT_CHUNK_SIZE, DEFAULT_LENGTH_TOL, DEFAULT_MAX_STEPS, DEFAULT_N_MAX,
     MODEL_CHOICES,
@@ -195,7 +195,8 @@ def read_cases_file(path, perturbation=DEFAULT_PERTURBATION, n=6, auto_top=None)
             parquet = pq.ParquetFile(path)
             rows = parquet.metadata.num_rows
             names = parquet.schema_arrow.names
-            frame = None if rows > limit else pd.read_parquet(path)
+            # checked as loopsim's own files are (a table loopsim wrote carries checksums)
+            frame = None if rows > limit else io.read_table_checked(path).to_pandas()
         else:
             frame = pd.read_csv(path, nrows=limit + 1)
             rows, names = len(frame), list(frame.columns)
