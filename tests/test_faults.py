@@ -557,6 +557,27 @@ def test_disk_full_is_an_environment_error_and_the_sweep_resumes(tmp_path, capsy
     assert len(loopsim.read_results(str(out))) == 2
 
 
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="RLIMIT_FSIZE, /proc")
+def test_file_size_limit_is_an_environment_error(sweep, tmp_path):
+    """Issue 46.7: a write past the file-size limit (``ulimit -f``; EFBIG) is the machine's
+    fault like a full disk: one line, exit 3 (not 2, bad input), no file or temporary."""
+    import resource
+
+    def limited():
+        resource.setrlimit(resource.RLIMIT_FSIZE, (2048, resource.getrlimit(
+            resource.RLIMIT_FSIZE)[1]))
+
+    table = tmp_path / "out" / "cells.parquet"
+    table.parent.mkdir()
+    done = subprocess.run([sys.executable, "-m", "loopsim", "summary", sweep, "--out",
+                           str(table)], capture_output=True, text=True, preexec_fn=limited,
+                          timeout=300)
+    assert done.returncode == 3, done.stderr
+    err = done.stderr.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("loopsim: error:") and "too large" in err[0], err
+    assert listing_of(table.parent) == []
+
+
 @pytest.mark.parametrize("command", ["summary", "figures"])
 def test_disk_full_leaves_no_empty_figure(sweep, tmp_path, capsys, monkeypatch, command):
     """Issue 36.11: a figure that cannot be written (ENOSPC) exits 3 and leaves no PNG, not
