@@ -505,6 +505,57 @@ def test_run_out_removes_temporaries_of_killed_runs_only(tmp_path, capsys):
     io.read_table_checked(str(out), require_hash=True)
 
 
+def _dead_pid():
+    """The id of a process that has ended."""
+    child = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                           capture_output=True, text=True, check=True)
+    return int(child.stdout)
+
+
+def _run_file(path, snapshots):
+    assert main(["run", "--g0", "60", "--theta0", "30", "--n", "4", "--t-end", "1",
+                 "--snapshots", str(snapshots), "--no-twin", "--out", str(path)]) == 0
+    return str(path)
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="signals, one host")
+@pytest.mark.parametrize("signum, status", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_a_signal_during_animate_leaves_no_temporary(tmp_path, capsys, signum, status):
+    """Issue 46.6: a signal while ``animate`` writes (its early handler ends the process at
+    once) used to leave a 0-byte ``.tmp-*`` file: now one line, exit 130 / 143, nothing."""
+    run = _run_file(tmp_path / "run.parquet", 60)
+    capsys.readouterr()
+    out = tmp_path / "anim"
+    out.mkdir()
+    process = subprocess.Popen([sys.executable, "-m", "loopsim", "animate", run, "--out",
+                                str(out / "a.gif"), "--frames", "60"],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while not list(out.glob(".tmp-*")):  # the write has begun: frames being drawn
+        assert process.poll() is None and time.monotonic() < deadline, process.communicate()
+        time.sleep(0.01)
+    process.send_signal(signum)
+    _, stderr = process.communicate(timeout=60)
+    assert process.returncode == status, stderr
+    assert len(stderr.splitlines()) == 1 and "Traceback" not in stderr, stderr
+    assert listing_of(out) == []
+
+
+def test_the_next_write_removes_temporaries_of_dead_writers(tmp_path, capsys):
+    """Issue 46.6: a temporary left by a killed ``animate`` (SIGKILL: nothing can remove it
+    then) goes with the next write into its directory; a live process's stays."""
+    run = _run_file(tmp_path / "run.parquet", 5)
+    out = tmp_path / "anim"
+    out.mkdir()
+    host = socket.gethostname()
+    dead = out / f".tmp-{host}-{_dead_pid()}-abc.gif"
+    live = out / f".tmp-{host}-{os.getpid()}-abc.gif"
+    dead.write_bytes(b"")
+    live.write_bytes(b"")
+    assert main(["animate", run, "--out", str(out / "a.gif"), "--dpi", "40"]) == 0
+    assert listing_of(out) == sorted(["a.gif", live.name])
+
+
 def test_edited_sweep_file_is_damaged(sweep):
     """A flipped value in _sweep.json's configuration no longer matches its fingerprint."""
     path = os.path.join(sweep, io.SWEEP_FILE)

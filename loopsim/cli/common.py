@@ -147,9 +147,10 @@ def interrupted(signum, detail):
     if _is_program():
         sys.stdout.flush()
         sys.stderr.flush()
-        from .._signals import end_children
+        from .._signals import end_children, remove_temporaries
 
         end_children()
+        remove_temporaries()
         os._exit(status)
     return status
 
