@@ -358,6 +358,30 @@ def test_cases_file_columns_checked(tmp_path, capsys, header, rows, words):
     assert not (tmp_path / "s").exists()
 
 
+@pytest.mark.parametrize("lines, words", [
+    (["g0,theta0_deg,seed", "10,30,0", "60,30,0", "10,30.0,0"],
+     ["one case twice", "rows 0 and 2", "g0=10, theta0_deg=30"]),
+    (["g0,theta0_deg,method", "10,30,rkf45", "10,30,"],  # rkf45: the sweep's method here
+     ["cases 0 and 1 are one case twice", "method=rkf45"]),
+    (None, ["cases 0 and 2 are one case twice", "--g0"]),
+])
+def test_a_case_given_twice_is_refused_before_anything_is_written(tmp_path, capsys, lines,
+                                                                   words):
+    """Issue 46.5: a cases file (or a grid) holding one case twice used to run it twice,
+    and ``summary`` and ``report`` then refused the directory."""
+    if lines is None:
+        given = ["--g0", "10,60,10", "--theta0", "30"]
+    else:
+        (tmp_path / "cases.csv").write_text("\n".join(lines) + "\n")
+        given = ["--cases", str(tmp_path / "cases.csv")]
+    out = tmp_path / "s"
+    assert main(["sweep", "--n", "6", *given, "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1 and err.startswith("loopsim: error: "), err
+    assert all(w in err for w in words), err
+    assert not out.exists()
+
+
 def test_refused_rerun_options_leave_the_directory_usable(sweep, capsys):
     """An invalid --rtol or --atol of --rerun-failed is refused before anything is
     recorded in _sweep.json, so a later valid rerun is not blocked by it."""

@@ -2,6 +2,7 @@
 Parquet), and the checks a configuration passes before any work."""
 import dataclasses
 import itertools
+import json
 import math
 import os
 import re
@@ -232,7 +233,35 @@ def read_cases_file(path, perturbation=DEFAULT_PERTURBATION, n=6, auto_top=None)
                     "perturbation" in given and bool(given["perturbation"].iloc[i]))
             except ValueError as exc:
                 raise ValueError(f"cases file row {i}: {exc}") from None
+    repeat = repeated_case(cases)
+    if repeat is not None:
+        first, second = repeat
+        raise ValueError(f"cases file {path!r} holds one case twice: rows {first} and {second} "
+                         f"(counted from 0: {describe_case(cases[first])}); a sweep runs each "
+                         "case once, remove one of them")
     return cases
+
+
+def describe_case(case):
+    """A case's inputs as one line: 'g0=10, theta0_deg=30, n=6, seed=0, ...'."""
+    return ", ".join(f"{key}={value:g}" if isinstance(value, float) else f"{key}={value}"
+                     for key, value in case.items())
+
+
+def repeated_case(cases, config=None):
+    """(i, j), i < j, of the first case ``j`` that repeats an earlier case ``i`` (the same
+    inputs; with ``config``, a per-case override equal to the sweep's option is the same
+    as none), or None where every case is distinct."""
+    seen = {}
+    for index, case in enumerate(cases):
+        values = dict(case)
+        if config is not None:
+            values.update({key: case_option(config, case, key) for key in CASE_OVERRIDES})
+        key = json.dumps(values, sort_keys=True, default=str)
+        if key in seen:
+            return seen[key], index
+        seen[key] = index
+    return None
 
 
 def validate(config):
@@ -265,6 +294,11 @@ def validate(config):
                                "n_start" if config.n_auto else "n")
         except ValueError as exc:
             raise ValueError(f"case {case_id}: {exc}") from None
+    repeat = repeated_case(config.cases, config)
+    if repeat is not None:
+        raise ValueError(f"cases {repeat[0]} and {repeat[1]} are one case twice "
+                         f"({describe_case(config.cases[repeat[0]])}); a sweep runs each case "
+                         "once (a value given twice in --g0, --theta0 or --n?)")
     if config.slenderness is not None and not any(
             case_option(config, case, "model") == "nonlocal" for case in config.cases):
         raise ValueError(f"slenderness applies only to the nonlocal model, got slenderness="

@@ -257,9 +257,7 @@ def run_seeds_auto(config, out, targets, *, run_round, command_line=None, announ
     """
     targets.check()
     cells = [dict(case, seed=0) for case in config.cases]
-    validate(dataclasses.replace(config, cases=cells))
-    if len({cell_key(c) for c in cells}) != len(cells):
-        raise ValueError("--seeds auto needs distinct cells (g0, theta0, n, perturbation)")
+    validate(dataclasses.replace(config, cases=cells))  # distinct cells among the rest
     check_size(cells, targets)
     made = prepare(out, config, targets, command_line)
     if not made and os.path.isfile(os.path.join(out, io.STOPS_FILE)):
