@@ -171,14 +171,15 @@ STOP_COLUMNS = {
     "perturbation": RESULT_COLUMNS["perturbation"],
     "seeds": (COUNT, "seeds run for the cell"),
     "rounds": (COUNT, "rounds the cell took part in"),
-    "stop_reason": (TEXT, "why the cell stopped: deterministic, sharp or cap (--max-seeds reached) "
+    "stop_reason": (TEXT, "why the cell stopped: failed (every seed failed: no distribution, "
+                          "no check), deterministic, sharp or cap (--max-seeds reached) "
                           "(loopsim.seeding)"),
     "p_halfwidth": (PROBABILITY, "largest half-width of the regime shares' 95% Wilson "
                                  "intervals at the stop"),
     "tilt_halfwidth_deg": (DEG, "half-width of the median terminal tilt's 95% bootstrap "
                                 "interval at the stop"),
-    "runs": (TEXT, "trajectories (each run twin-checked or deterministic) or samples (the "
-                   "cell's outcome is a distribution)"),
+    "runs": (TEXT, "trajectories (each run twin-checked or deterministic), samples (the "
+                   "cell's outcome is a distribution) or none (every run failed)"),
     "twins": (COUNT, "rows of the cell with a twin run"),
     "check_seeds": (COUNT, "seeds of the distribution check of a sampled cell (0: none)"),
     "check_verdict": (TEXT, "the check's verdict (loopsim.compare; empty: no check)"),
