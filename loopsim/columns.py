@@ -118,7 +118,8 @@ SUMMARY_COLUMNS = {
     "determined": (COUNT, "rows of the cell whose outcome is determined (a twin agreed)"),
     "steady": (COUNT, "rows of the cell that reached a steady state before t_end (stop_reason "
                       "steady); the others ran to t_end, their terminal values the state there, or "
-                      "failed (0 with --no-early-stop, which tests no run)"),
+                      "failed (empty, unknown, for a sweep run with --no-early-stop: no run was "
+                      "tested)"),
     **{f"p_{regime}{end}": (PROBABILITY, f"{what} of the regime {label}")
        for regime, label in (("stable", "stable"), ("in_plane", "in-plane"), ("3d", "3d"),
                              ("failed", "failed"))
