@@ -15,10 +15,10 @@ seeds and doubles them, round after round, until one of these holds, checked in 
 
 A cell whose runs are *samples* (:func:`runs_are_samples`: some run succeeded, and its
 seeds end in different regimes, or some run's stricter twin ends elsewhere) needs no more
-twins: each would only
-prove once more that one run is a sample.  Its later seeds run without twins, and its
-distribution is checked instead against a subsample at the twins' stricter tolerances
-(``check_seeds`` seeds, ``sweeps.seeds_auto``; verdict by ``summary.compare``).
+twins: each would only prove once more that one run is a sample.  Its later seeds run
+without twins, and its distribution is checked instead against a subsample at the twins'
+stricter tolerances (``check_seeds`` seeds, ``sweeps.seeds_auto``; verdict by
+``summary.compare``).
 
 The rule reads only a cell's finished rows, which are reproducible bit for bit, so the
 rounds it plans are too: a resumed ``--seeds auto`` sweep plans what the interrupted one
