@@ -248,16 +248,23 @@ def describe_case(case):
                      for key, value in case.items())
 
 
+def _case_key(values):
+    """A hashable key of a case's values (its items; as JSON where a value is not
+    hashable)."""
+    try:
+        return frozenset(values.items())
+    except TypeError:
+        return json.dumps(values, sort_keys=True, default=str)
+
+
 def repeated_case(cases, config=None):
     """(i, j), i < j, of the first case ``j`` that repeats an earlier case ``i`` (the same
     inputs; with ``config``, a per-case override equal to the sweep's option is the same
-    as none), or None where every case is distinct."""
+    as none, as :func:`case_option` reads it), or None where every case is distinct."""
+    options = {} if config is None else {key: getattr(config, key) for key in CASE_OVERRIDES}
     seen = {}
     for index, case in enumerate(cases):
-        values = dict(case)
-        if config is not None:
-            values.update({key: case_option(config, case, key) for key in CASE_OVERRIDES})
-        key = json.dumps(values, sort_keys=True, default=str)
+        key = _case_key({**options, **case})
         if key in seen:
             return seen[key], index
         seen[key] = index
