@@ -6,6 +6,10 @@ Python user importing the package) :func:`install_early` makes SIGINT and SIGTER
 process in those seconds with one line and exit status 128 + signum (130, 143), without
 a traceback.  Commands replace the handler with their own while they work (a sweep keeps
 what has finished; ``sweeps.stop_on_signals``) and restore it afterwards.
+
+Ending at once (``os._exit``) skips the cleanup of an atomic write in progress
+(``io.integrity``), so the temporary files this process is writing are registered here
+(:func:`track_temporary`) and removed before it exits (:func:`remove_temporaries`).
 """
 import os
 import signal
@@ -22,6 +26,32 @@ def is_program(argv=None, orig_argv=None):
             os.path.join("loopsim", "__main__.py")):
         return True
     return any(a == "-m" and b == "loopsim" for a, b in zip(orig_argv, orig_argv[1:]))
+
+
+#: Temporary files of atomic writes in progress in this process (``io.integrity``).
+_TEMPORARIES = set()
+
+
+def track_temporary(path):
+    """Register ``path``, a temporary file this process is writing, for
+    :func:`remove_temporaries`."""
+    _TEMPORARIES.add(path)
+
+
+def untrack_temporary(path):
+    """Forget ``path`` (renamed into place, or removed)."""
+    _TEMPORARIES.discard(path)
+
+
+def remove_temporaries():
+    """Remove the registered temporary files (the process is ending without their own
+    cleanup: a write cut short leaves no ``.tmp-*`` file)."""
+    for path in list(_TEMPORARIES):
+        try:
+            os.remove(path)
+        except OSError:
+            pass
+        _TEMPORARIES.discard(path)
 
 
 def end_children():
@@ -45,6 +75,7 @@ def _exit_at_once(signum, frame):
     os.write(2, f"loopsim: interrupted by {name}: stopped (files already written are "
                 "complete; a sweep resumes when re-run)\n".encode())
     end_children()
+    remove_temporaries()
     os._exit(128 + signum)
 
 

@@ -118,7 +118,8 @@ SUMMARY_COLUMNS = {
     "determined": (COUNT, "rows of the cell whose outcome is determined (a twin agreed)"),
     "steady": (COUNT, "rows of the cell that reached a steady state before t_end (stop_reason "
                       "steady); the others ran to t_end, their terminal values the state there, or "
-                      "failed (0 with --no-early-stop, which tests no run)"),
+                      "failed (empty, unknown, for a sweep run with --no-early-stop: no run was "
+                      "tested)"),
     **{f"p_{regime}{end}": (PROBABILITY, f"{what} of the regime {label}")
        for regime, label in (("stable", "stable"), ("in_plane", "in-plane"), ("3d", "3d"),
                              ("failed", "failed"))
@@ -171,14 +172,15 @@ STOP_COLUMNS = {
     "perturbation": RESULT_COLUMNS["perturbation"],
     "seeds": (COUNT, "seeds run for the cell"),
     "rounds": (COUNT, "rounds the cell took part in"),
-    "stop_reason": (TEXT, "why the cell stopped: deterministic, sharp or cap (--max-seeds reached) "
+    "stop_reason": (TEXT, "why the cell stopped: failed (every seed failed: no distribution, "
+                          "no check), deterministic, sharp or cap (--max-seeds reached) "
                           "(loopsim.seeding)"),
     "p_halfwidth": (PROBABILITY, "largest half-width of the regime shares' 95% Wilson "
                                  "intervals at the stop"),
     "tilt_halfwidth_deg": (DEG, "half-width of the median terminal tilt's 95% bootstrap "
                                 "interval at the stop"),
-    "runs": (TEXT, "trajectories (each run twin-checked or deterministic) or samples (the "
-                   "cell's outcome is a distribution)"),
+    "runs": (TEXT, "trajectories (each run twin-checked or deterministic), samples (the "
+                   "cell's outcome is a distribution) or none (every run failed)"),
     "twins": (COUNT, "rows of the cell with a twin run"),
     "check_seeds": (COUNT, "seeds of the distribution check of a sampled cell (0: none)"),
     "check_verdict": (TEXT, "the check's verdict (loopsim.compare; empty: no check)"),

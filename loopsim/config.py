@@ -40,9 +40,10 @@ def __getattr__(name):
 
 
 #: OSError numbers that are the machine's fault, not the input's: the command line exits
-#: 3 on them (a full disk, a read-only filesystem, an I/O error, no memory or files left).
+#: 3 on them (a full disk, a read-only filesystem, an I/O error, no memory or files left,
+#: a file-size limit reached: ``ulimit -f``, or the filesystem's largest file).
 ENVIRONMENT_ERRNOS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EIO,
-                                errno.ENOMEM, errno.EMFILE, errno.ENFILE})
+                                errno.ENOMEM, errno.EMFILE, errno.ENFILE, errno.EFBIG})
 
 #: Default penalty rate of the length-creation term (docs/model.md, "Choice of the length
 #: penalty w").

@@ -3,6 +3,8 @@
 A cell (one point of the sweep's inputs, the seed left out) starts with ``min_seeds``
 seeds and doubles them, round after round, until one of these holds, checked in order:
 
+* ``failed``: every seed failed (no run succeeded): the cell has no outcome, so no
+  distribution to sharpen or check;
 * ``deterministic``: every seed succeeded, in the same regime, and the terminal tilts and
   aspect ratios of all seeds lie within ``tilt_tol_deg`` and ``aspect_tol`` of each other
   (max − min): more seeds cannot change the answer (stable loops, settled in-plane loops);
@@ -11,11 +13,12 @@ seeds and doubles them, round after round, until one of these holds, checked in 
   at most ``tilt_halfwidth_deg``;
 * ``cap``: the cell has ``max_seeds`` seeds.
 
-A cell whose runs are *samples* (:func:`runs_are_samples`: its seeds end in different
-regimes, or some run's stricter twin ends elsewhere) needs no more twins: each would only
-prove once more that one run is a sample.  Its later seeds run without twins, and its
-distribution is checked instead against a subsample at the twins' stricter tolerances
-(``check_seeds`` seeds, ``sweeps.seeds_auto``; verdict by ``summary.compare``).
+A cell whose runs are *samples* (:func:`runs_are_samples`: some run succeeded, and its
+seeds end in different regimes, or some run's stricter twin ends elsewhere) needs no more
+twins: each would only prove once more that one run is a sample.  Its later seeds run
+without twins, and its distribution is checked instead against a subsample at the twins'
+stricter tolerances (``check_seeds`` seeds, ``sweeps.seeds_auto``; verdict by
+``summary.compare``).
 
 The rule reads only a cell's finished rows, which are reproducible bit for bit, so the
 rounds it plans are too: a resumed ``--seeds auto`` sweep plans what the interrupted one
@@ -32,7 +35,7 @@ from .outcomes import REGIMES
 from .summary import bootstrap_interval, wilson_interval
 
 #: Why a cell stopped adding seeds (``stop_reason``); ``CONTINUE`` while it has not.
-DETERMINISTIC, SHARP, CAP, CONTINUE = "deterministic", "sharp", "cap", ""
+FAILED, DETERMINISTIC, SHARP, CAP, CONTINUE = "failed", "deterministic", "sharp", "cap", ""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -91,11 +94,18 @@ def is_deterministic(rows, targets):
     return bool(np.ptp(tilt) <= targets.tilt_tol_deg and np.ptp(aspect) <= targets.aspect_tol)
 
 
+def any_succeeded(rows):
+    """Whether some run of a cell succeeded (a regime other than "failed")."""
+    return bool(rows["regime"].ne("failed").any())
+
+
 def runs_are_samples(rows):
     """Whether a cell's runs are samples of a distribution rather than determined
-    trajectories: its seeds end in more than one regime, or a run's twin (at stricter
-    tolerances) ends elsewhere (``determined`` False)."""
-    return bool(rows["regime"].nunique() > 1 or rows["determined"].eq(False).any())
+    trajectories: some run succeeded (:func:`any_succeeded`; a cell with none has no
+    distribution), and its seeds end in more than one regime, or a run's twin (at
+    stricter tolerances) ends elsewhere (``determined`` False)."""
+    return any_succeeded(rows) and bool(rows["regime"].nunique() > 1
+                                        or rows["determined"].eq(False).any())
 
 
 def decide(rows, targets):
@@ -105,6 +115,8 @@ def decide(rows, targets):
     have = len(rows)
     if have < targets.min_seeds:
         return CONTINUE, targets.min_seeds
+    if not any_succeeded(rows):
+        return FAILED, have
     if is_deterministic(rows, targets):
         return DETERMINISTIC, have
     p_width, tilt_width = widths(rows)

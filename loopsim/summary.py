@@ -7,8 +7,10 @@ whatever a grid or a cases file can set per case).  A cell holds each seed at mo
 two rows with one seed in one cell differ in an input the table does not record (an
 ``initial`` shape, say), and are refused rather than merged.  Per cell:
 
-* ``seeds``, ``resolved``, ``determined``: how many rows, and how many of them are
-  resolved and determined (``loopsim.outcomes``);
+* ``seeds``, ``resolved``, ``determined``, ``steady``: how many rows, and how many of
+  them are resolved and determined (``loopsim.outcomes``) and reached a steady state
+  before ``t_end`` (unknown, ``<NA>``, where the sweep ran without the early stop:
+  :func:`steady_tested`);
 * ``p_<regime>`` for each regime, with its 95 % Wilson score interval
   ``p_<regime>_low``, ``p_<regime>_high``:
 
@@ -96,12 +98,22 @@ def cell_groups(frame, by):
     return groups
 
 
-def _cell_row(rows, seed):
+def steady_tested(frame):
+    """Whether the rows of a results table were tested for a steady state (the early stop
+    could end them, so ``stop_reason`` "steady" counts them): False where the table records
+    that its sweep ran with ``--no-early-stop`` (``early_stop`` False in
+    ``frame.attrs["loopsim"]["sweep_config"]``, as :func:`loopsim.read_results` gives it),
+    True otherwise."""
+    config = frame.attrs.get("loopsim", {}).get("sweep_config")
+    return not (isinstance(config, dict) and config.get("early_stop") is False)
+
+
+def _cell_row(rows, seed, tested=True):
     trials = len(rows)
     out = dict(seeds=trials, resolved=int(rows["resolved"].sum()),
                determined=int(rows["determined"].eq(True).sum()))
     if "stop_reason" in rows:
-        out["steady"] = int(rows["stop_reason"].eq("steady").sum())
+        out["steady"] = int(rows["stop_reason"].eq("steady").sum()) if tested else pd.NA
     for regime in REGIMES:
         name = regime.replace("-", "_")
         hits = int((rows["regime"] == regime).sum())
@@ -150,7 +162,9 @@ def summarize(frame, by=None, seed=0):
         * ``seeds``, ``resolved``, ``determined``, ``steady``: how many rows, and how
           many of them are resolved, determined, and reached a steady state before
           ``t_end`` (the others ran to ``t_end``, their "terminal" values the state
-          there, or failed; ``steady`` only where ``frame`` has ``stop_reason``);
+          there, or failed; ``steady`` only where ``frame`` has ``stop_reason``, and
+          unknown, ``<NA>``, where its sweep ran with ``--no-early-stop``:
+          :func:`steady_tested`);
         * ``p_<regime>`` for each regime (stable, in_plane, 3d, failed), with its 95 %
           Wilson score interval ``p_<regime>_low``, ``p_<regime>_high``:
           (p̂ + z²/2N ± z sqrt(p̂(1 − p̂)/N + z²/4N²)) / (1 + z²/N), z = Φ⁻¹(0.975);
@@ -180,8 +194,12 @@ def summarize(frame, by=None, seed=0):
         raise ValueError(f"no column(s) {missing} to group the cells by")
     if not len(frame):
         raise ValueError("no rows to summarise")
-    rows = [dict(zip(by, key), **_cell_row(group, seed)) for key, group in cell_groups(frame, by)]
+    tested = steady_tested(frame)
+    rows = [dict(zip(by, key), **_cell_row(group, seed, tested))
+            for key, group in cell_groups(frame, by)]
     table = pd.DataFrame(rows)
+    if "steady" in table and not tested:
+        table["steady"] = table["steady"].astype("Int64")  # unknown: <NA>, empty in Parquet
     table.attrs["loopsim_summary"] = dict(cells_by=by, bootstrap_seed=seed,
                                           bootstrap_resamples=BOOTSTRAP_RESAMPLES,
                                           interval="95 % (Wilson; percentile bootstrap)")

@@ -49,6 +49,10 @@ def png_data_uri(fig, dpi=REPORT_DPI):
 
 
 def _cell(value):
+    import pandas as pd
+
+    if value is None or value is pd.NA:  # unknown (summary's steady without early stop)
+        return ""
     if isinstance(value, float):
         return "" if value != value else f"{value:.4g}"
     return html.escape(str(value))
@@ -56,7 +60,7 @@ def _cell(value):
 
 def table_html(frame, columns=None, table_id=None):
     """An HTML table of ``frame`` (its ``columns``, default all): a header row, then one
-    row per row, floats to 4 significant digits (NaN as an empty cell)."""
+    row per row, floats to 4 significant digits (NaN and unknown values as empty cells)."""
     columns = [c for c in (columns or frame.columns) if c in frame]
     head = "".join(f"<th>{html.escape(str(c))}</th>" for c in columns)
     body = "".join("<tr>" + "".join(f"<td>{_cell(v)}</td>" for v in row) + "</tr>\n"

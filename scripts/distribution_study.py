@@ -9,7 +9,7 @@ Usage: python scripts/distribution_study.py [--runs runs/distributions] [--threa
 
 1. ``--seeds auto`` at ``--n auto`` (with twins) over the grid (``--g0`` and ``--theta0``
    as ``loopsim sweep`` takes them: ``10:150:8`` or ``30,60``): every point gets seeds
-   until it is deterministic, sharp or at --max-seeds (``RUNS/auto``);
+   until it is deterministic, sharp or at --max-seeds, or has failed (``RUNS/auto``);
 2. the points that did not stop as deterministic (those at --check-g0 and --check-theta0
    only, when given) again, with --check-seeds fixed seeds and no twins (``RUNS/<check>``), either at
    10x stricter rtol and atol (``--check tolerance``) or at the fixed order --check-n
@@ -30,9 +30,10 @@ import os
 import time
 
 import pandas as pd
+import pyarrow as pa
 
 import loopsim
-from loopsim import columns, config, io, refinement, shapes, spectral, sweeps
+from loopsim import columns, config, io, refinement, seeding, shapes, spectral, sweeps
 from loopsim.cli.common import directory_name, print_and_write, save_distribution_figure
 
 #: What the second step varies, and the tolerances of ``--check tolerance``.
@@ -48,9 +49,9 @@ def markdown(frame, columns, formats):
 
 
 def check_cells(stops, g0, theta0):
-    """The cells to check: not deterministic, and at one of ``g0`` and ``theta0`` when
-    given (None: any)."""
-    cells = stops[stops["stop_reason"] != "deterministic"]
+    """The cells to check: not deterministic and not failed (no run succeeded: nothing to
+    compare), and at one of ``g0`` and ``theta0`` when given (None: any)."""
+    cells = stops[~stops["stop_reason"].isin([seeding.DETERMINISTIC, seeding.FAILED])]
     for column, values in (("g0", g0), ("theta0_deg", theta0)):
         if values is not None:
             cells = cells[cells[column].isin(values)]
@@ -79,7 +80,7 @@ def resolution_check(cells, args, directory):
     for cell in cells:
         path = os.path.join(directory, f"g{cell['g0']:g}_t{cell['theta0_deg']:g}.parquet")
         if os.path.exists(path):
-            frames.append(pd.read_parquet(path))
+            frames.append(io.read_table_checked(path).to_pandas())  # damaged: named
         else:
             todo.append((cell, path))
     context = multiprocessing.get_context("spawn")  # no fork of a process that ran prange
@@ -90,8 +91,7 @@ def resolution_check(cells, args, directory):
                 (cell["g0"], cell["theta0_deg"], seed, args.check_n)
                 for seed in range(args.check_seeds)])))
             frame = pd.DataFrame(rows)
-            frame.to_parquet(path + ".part", index=False)
-            os.replace(path + ".part", path)
+            io.write_table_atomically(pa.Table.from_pandas(frame, preserve_index=False), path)
             print(f"{args.check} check: g0 = {cell['g0']:g}, theta0 = {cell['theta0_deg']:g}: "
                   f"{frame['wall_s'].sum():.0f} s summed", flush=True)
             frames.append(frame)

@@ -3,7 +3,7 @@ probabilities").
 
 Usage: python scripts/paper_range_study.py [--runs runs] [--threads T] [--data data]
                                            [--figure docs/figures/paper_range.png]
-                                           [--max-seeds 8] [--quick]
+                                           [--max-seeds 8] [--quick] [--read-only]
 
 The paper's Fig. 5 grid is ``--g0 10:350:15 --theta0 6:90:15`` (225 cells).  This study
 runs, with ``--seeds auto --n auto`` (twins, at most --max-seeds seeds, each sampled
@@ -32,7 +32,13 @@ prints the cost (the runs' ``wall_s`` scaled by (nfev + twin_nfev) / nfev, and t
 runs') and the cells that are certain, mixed, and those where seed 0's regime is not
 the most probable one; draws the figure (``loopsim summary --figure``'s panels).
 Every sweep resumes: re-run the same command after an interruption.  ``--read-only``
-tabulates the parts that have finished and names the others.
+tabulates the parts that have finished and names the others (one line and exit status 1
+where none has).
+
+``--quick`` (a few cells, t = 0.5, n <= 8: it exercises the script) keeps everything it
+writes in one folder of its own, ``runs/paper_range_quick/`` by default (its sweeps, both
+tables and the figure), and refuses to write over the committed study's tables and figure
+(exit status 2).
 """
 import argparse
 import os
@@ -59,6 +65,14 @@ PARTS = (("paper_range_low", G0[:6], THETA0), ("paper_range_band", G0[6:], THETA
          ("paper_range_mid66", G0[6:10], THETA0[10:12]))
 QUICK_PARTS = (("paper_range_low", G0[:2], THETA0[::7]), ("paper_range_band", G0[6:7],
                                                             THETA0[:1]))
+#: Where ``--quick`` writes by default: its sweeps, tables and figure.
+QUICK_RUNS = os.path.join("runs", "paper_range_quick")
+#: The study's committed outputs (relative to the repository, or to the working directory
+#: the study runs in): ``--quick`` never writes over them.
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SUMMARY_FILE, STOPS_FILE = "paper_range_summary.parquet", "paper_range_stops.parquet"
+COMMITTED = (os.path.join("data", SUMMARY_FILE), os.path.join("data", STOPS_FILE),
+             os.path.join("docs", "figures", "paper_range.png"))
 
 
 def values(array):
@@ -86,19 +100,76 @@ def cost(frame, checks):
     return runs, float(checks["wall_s"].sum()) if len(checks) else 0.0
 
 
-def main():
+def parse_args(argv=None):
+    """The command line, with the output places filled in (:func:`resolve_outputs`);
+    ValueError (one line) where ``--quick`` would write over the committed study."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--runs", default="runs")
-    parser.add_argument("--data", default="data")
-    parser.add_argument("--figure", default=os.path.join("docs", "figures", "paper_range.png"))
+    parser.add_argument("--runs", default=None,
+                        help=f"the sweeps' folder (default: runs; with --quick {QUICK_RUNS})")
+    parser.add_argument("--data", default=None,
+                        help="the tables' folder (default: data; with --quick --runs)")
+    parser.add_argument("--figure", default=None,
+                        help="the figure (default: docs/figures/paper_range.png; with --quick "
+                             "RUNS/paper_range.png; empty: none)")
     parser.add_argument("--threads", type=int, default=os.cpu_count() or 1)
     parser.add_argument("--max-seeds", type=int, default=8)
     parser.add_argument("--read-only", action="store_true",
                         help="run nothing: tabulate the parts that have finished (their stop "
                              "table written) and name the others")
     parser.add_argument("--quick", action="store_true",
-                        help="a few cells, t = 0.5, n <= 8: exercises the script")
-    args = parser.parse_args()
+                        help="a few cells, t = 0.5, n <= 8: exercises the script (writes under "
+                             f"{QUICK_RUNS} by default, never over the committed study)")
+    return resolve_outputs(parser.parse_args(argv))
+
+
+def resolve_outputs(args):
+    """``args`` with ``runs``, ``data`` and ``figure`` filled in where not given: the
+    study's places, or with ``--quick`` one folder of its own (:data:`QUICK_RUNS`).  A
+    ValueError where ``--quick`` would write a table or the figure over one of the
+    committed study's (:data:`COMMITTED`, in the repository or the working directory)."""
+    if args.runs is None:
+        args.runs = QUICK_RUNS if args.quick else "runs"
+    if args.data is None:
+        args.data = args.runs if args.quick else "data"
+    if args.figure is None:
+        args.figure = (os.path.join(args.runs, "paper_range.png") if args.quick
+                       else os.path.join("docs", "figures", "paper_range.png"))
+    if args.quick:
+        committed = {os.path.realpath(os.path.join(base, path))
+                     for base in (ROOT, os.getcwd()) for path in COMMITTED}
+        for path in (os.path.join(args.data, SUMMARY_FILE), os.path.join(args.data, STOPS_FILE),
+                     args.figure):
+            if path and os.path.realpath(path) in committed:
+                raise ValueError(f"--quick would write over the committed study's {path!r}; "
+                                 "leave --data and --figure out (they default to --runs) or "
+                                 "give other places")
+    return args
+
+
+def steady_lines(table):
+    """The printout's lines on the cells with seeds not steady at ``t_end`` (their tilt a
+    snapshot), from a summary table; cells whose ``steady`` is unknown (``<NA>``: run with
+    ``--no-early-stop``, no run tested) are counted apart, never as steady or moving."""
+    known = table[table["steady"].notna()]
+    moving = known[known["steady"] < known["seeds"]]
+    lines = [f"cells with seeds not steady at t_end (their tilt a snapshot): {len(moving)}; "
+             f"runs not steady: {int((known['seeds'] - known['steady']).sum())} of "
+             f"{int(known['seeds'].sum())}"]
+    lines += [f"  ({cell['g0']:.1f}, {cell['theta0_deg']:g}°): "
+              f"{int(cell['seeds'] - cell['steady'])} of {int(cell['seeds'])}"
+              for _, cell in moving.iterrows()]
+    if len(known) < len(table):
+        lines.append(f"cells whose steady state is unknown (run with --no-early-stop: no run "
+                     f"tested): {len(table) - len(known)}")
+    return lines
+
+
+def main():
+    try:
+        args = parse_args()
+    except ValueError as exc:
+        print(f"paper_range_study: error: {exc}", file=sys.stderr)
+        sys.exit(2)
     frames, stops, checks = [], [], []
     for name, g0, theta0 in QUICK_PARTS if args.quick else PARTS:
         path = os.path.join(args.runs, name)
@@ -112,6 +183,9 @@ def main():
         check = os.path.join(path, io.CHECK_DIR)
         if os.path.isdir(check):
             checks.append(io.read_results(check))
+    if not frames:  # --read-only before any part has finished
+        sys.exit(f"paper_range_study: no part has finished in {args.runs!r} (no stop table "
+                 "yet): nothing to tabulate")
     frame = pd.concat(frames, ignore_index=True)
     stop = pd.concat(stops, ignore_index=True).drop(columns="part")
     stop["n"] = stop["n"].astype("int64")
@@ -121,9 +195,9 @@ def main():
     meta = dict(summary_of=" + ".join(sorted(set(frame["part"]))))
     shown = ["g0", "theta0_deg", "seeds", "determined", "p_stable", "p_in_plane", "p_3d",
              "tilt_median", "tilt_median_low", "tilt_median_high"]
-    print_and_write(table, os.path.join(args.data, "paper_range_summary.parquet"), meta,
+    print_and_write(table, os.path.join(args.data, SUMMARY_FILE), meta,
                     shown, declarations=columns.SUMMARY_COLUMNS)
-    print_and_write(stop, os.path.join(args.data, "paper_range_stops.parquet"), meta,
+    print_and_write(stop, os.path.join(args.data, STOPS_FILE), meta,
                     ["g0", "theta0_deg", "seeds", "stop_reason", "runs", "check_verdict",
                      "check_tilt_wasserstein"], declarations=columns.STOP_COLUMNS)
     runs_s, check_s = cost(frame, check_rows)
@@ -149,13 +223,7 @@ def main():
         print(f"  ({g:.1f}, {t:g}°): seed 0 {one}, most probable {most}")
     print("by regime of the most probable outcome (a/b: a tie): "
           + ", ".join(f"{k} {v}" for k, v in likeliest.value_counts().items()))
-    moving = table[table["steady"] < table["seeds"]]
-    print(f"cells with seeds not steady at t_end (their tilt a snapshot): {len(moving)}; "
-          f"runs not steady: {int((table['seeds'] - table['steady']).sum())} of "
-          f"{int(table['seeds'].sum())}")
-    for _, cell in moving.iterrows():
-        print(f"  ({cell['g0']:.1f}, {cell['theta0_deg']:g}°): "
-              f"{int(cell['seeds'] - cell['steady'])} of {int(cell['seeds'])}")
+    print("\n".join(steady_lines(table)))
     if args.figure:
         save_distribution_figure(table, frame.drop(columns="part"), args.figure, dpi=FIGURE_DPI)
         print(f"figure: {args.figure}")

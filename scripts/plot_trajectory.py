@@ -12,15 +12,17 @@ import matplotlib
 
 matplotlib.use("Agg")
 
-import pyarrow.parquet as pq  # noqa: E402
-
-from loopsim import figures, io  # noqa: E402
+from loopsim import figures  # noqa: E402
+from loopsim.figures.suite import read_run  # noqa: E402
 
 
 def main(path, figure):
-    summary = io.read_metadata(path)["summary"]
+    try:  # checked as loopsim's own readers check it: a damaged file is named, not drawn
+        trajectory, summary = read_run(path)
+    except ValueError as exc:
+        sys.exit(f"plot_trajectory: error: {exc}")
     title = f"g0 = {summary['g0']:g}, θ0 = {summary['theta0_deg']:g}°, n = {summary['n']}"
-    fig = figures.trajectory(pq.read_table(path).to_pandas(), summary["n"], title)
+    fig = figures.trajectory(trajectory, summary["n"], title)
     figures.save(fig, figure, dpi=150)
     print(f"wrote {figure}")
 

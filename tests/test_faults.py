@@ -260,6 +260,35 @@ def test_damaged_chunk_as_initial_is_refused(sweep, capsys):
     assert "damaged" in capsys.readouterr().err
 
 
+def test_damaged_run_file_is_refused_by_animate_and_figures(sweep, tmp_path, capsys):
+    """Issue 46.1: a flipped bit in a run file's coefficients used to be drawn with exit 0;
+    ``animate`` and ``figures`` read run files checked, as sweep chunks are read."""
+    run = str(tmp_path / "run.parquet")
+    assert main(["run", "--g0", "60", "--theta0", "30", "--n", "4", "--t-end", "0.05",
+                 "--snapshots", "5", "--no-twin", "--out", run]) == 0
+    capsys.readouterr()
+    _silent_flip(run, "x")
+    gif, figs = tmp_path / "a.gif", tmp_path / "figs"
+    for argv in (["animate", run, "--out", str(gif)],
+                 ["figures", sweep, run, "--out", str(figs), "--only", "evolution"]):
+        assert main(argv) == 2, argv
+        err = capsys.readouterr().err
+        assert len(err.splitlines()) == 1 and "damaged" in err and run in err, err
+    assert not gif.exists() and not figs.exists()
+
+
+def test_damaged_parquet_cases_file_is_refused(tmp_path, capsys):
+    """Issue 46.1: a cases file loopsim wrote (with checksums) is read checked too."""
+    path = str(tmp_path / "cases.parquet")
+    io.write_table_atomically(pa.table({"g0": np.linspace(10.0, 60.0, 50),
+                                        "theta0_deg": np.full(50, 30.0)}), path)
+    _silent_flip(path, "g0")
+    assert main(["sweep", "--n", "4", "--cases", path, "--out", str(tmp_path / "s")]) == 2
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1 and "damaged" in err and path in err, err
+    assert not (tmp_path / "s").exists()
+
+
 # ---- sizes and inputs bounded before any work --------------------------------------------
 def _point_file(path, rows):
     s = np.linspace(0.0, 2 * np.pi, rows, endpoint=False)
@@ -327,6 +356,30 @@ def test_cases_file_columns_checked(tmp_path, capsys, header, rows, words):
     err = capsys.readouterr().err
     assert len(err.splitlines()) == 1 and all(w in err for w in words), err
     assert not (tmp_path / "s").exists()
+
+
+@pytest.mark.parametrize("lines, words", [
+    (["g0,theta0_deg,seed", "10,30,0", "60,30,0", "10,30.0,0"],
+     ["one case twice", "rows 0 and 2", "g0=10, theta0_deg=30"]),
+    (["g0,theta0_deg,method", "10,30,rkf45", "10,30,"],  # rkf45: the sweep's method here
+     ["cases 0 and 1 are one case twice", "method=rkf45"]),
+    (None, ["cases 0 and 2 are one case twice", "--g0"]),
+])
+def test_a_case_given_twice_is_refused_before_anything_is_written(tmp_path, capsys, lines,
+                                                                   words):
+    """Issue 46.5: a cases file (or a grid) holding one case twice used to run it twice,
+    and ``summary`` and ``report`` then refused the directory."""
+    if lines is None:
+        given = ["--g0", "10,60,10", "--theta0", "30"]
+    else:
+        (tmp_path / "cases.csv").write_text("\n".join(lines) + "\n")
+        given = ["--cases", str(tmp_path / "cases.csv")]
+    out = tmp_path / "s"
+    assert main(["sweep", "--n", "6", *given, "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1 and err.startswith("loopsim: error: "), err
+    assert all(w in err for w in words), err
+    assert not out.exists()
 
 
 def test_refused_rerun_options_leave_the_directory_usable(sweep, capsys):
@@ -476,6 +529,57 @@ def test_run_out_removes_temporaries_of_killed_runs_only(tmp_path, capsys):
     io.read_table_checked(str(out), require_hash=True)
 
 
+def _dead_pid():
+    """The id of a process that has ended."""
+    child = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"],
+                           capture_output=True, text=True, check=True)
+    return int(child.stdout)
+
+
+def _run_file(path, snapshots):
+    assert main(["run", "--g0", "60", "--theta0", "30", "--n", "4", "--t-end", "1",
+                 "--snapshots", str(snapshots), "--no-twin", "--out", str(path)]) == 0
+    return str(path)
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="signals, one host")
+@pytest.mark.parametrize("signum, status", [(signal.SIGINT, 130), (signal.SIGTERM, 143)])
+def test_a_signal_during_animate_leaves_no_temporary(tmp_path, capsys, signum, status):
+    """Issue 46.6: a signal while ``animate`` writes (its early handler ends the process at
+    once) used to leave a 0-byte ``.tmp-*`` file: now one line, exit 130 / 143, nothing."""
+    run = _run_file(tmp_path / "run.parquet", 60)
+    capsys.readouterr()
+    out = tmp_path / "anim"
+    out.mkdir()
+    process = subprocess.Popen([sys.executable, "-m", "loopsim", "animate", run, "--out",
+                                str(out / "a.gif"), "--frames", "60"],
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while not list(out.glob(".tmp-*")):  # the write has begun: frames being drawn
+        assert process.poll() is None and time.monotonic() < deadline, process.communicate()
+        time.sleep(0.01)
+    process.send_signal(signum)
+    _, stderr = process.communicate(timeout=60)
+    assert process.returncode == status, stderr
+    assert len(stderr.splitlines()) == 1 and "Traceback" not in stderr, stderr
+    assert listing_of(out) == []
+
+
+def test_the_next_write_removes_temporaries_of_dead_writers(tmp_path, capsys):
+    """Issue 46.6: a temporary left by a killed ``animate`` (SIGKILL: nothing can remove it
+    then) goes with the next write into its directory; a live process's stays."""
+    run = _run_file(tmp_path / "run.parquet", 5)
+    out = tmp_path / "anim"
+    out.mkdir()
+    host = socket.gethostname()
+    dead = out / f".tmp-{host}-{_dead_pid()}-abc.gif"
+    live = out / f".tmp-{host}-{os.getpid()}-abc.gif"
+    dead.write_bytes(b"")
+    live.write_bytes(b"")
+    assert main(["animate", run, "--out", str(out / "a.gif"), "--dpi", "40"]) == 0
+    assert listing_of(out) == sorted(["a.gif", live.name])
+
+
 def test_edited_sweep_file_is_damaged(sweep):
     """A flipped value in _sweep.json's configuration no longer matches its fingerprint."""
     path = os.path.join(sweep, io.SWEEP_FILE)
@@ -526,6 +630,27 @@ def test_disk_full_is_an_environment_error_and_the_sweep_resumes(tmp_path, capsy
     monkeypatch.setattr(parquet, "write_table", real_write)
     assert main(argv) == 0
     assert len(loopsim.read_results(str(out))) == 2
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="RLIMIT_FSIZE, /proc")
+def test_file_size_limit_is_an_environment_error(sweep, tmp_path):
+    """Issue 46.7: a write past the file-size limit (``ulimit -f``; EFBIG) is the machine's
+    fault like a full disk: one line, exit 3 (not 2, bad input), no file or temporary."""
+    import resource
+
+    def limited():
+        resource.setrlimit(resource.RLIMIT_FSIZE, (2048, resource.getrlimit(
+            resource.RLIMIT_FSIZE)[1]))
+
+    table = tmp_path / "out" / "cells.parquet"
+    table.parent.mkdir()
+    done = subprocess.run([sys.executable, "-m", "loopsim", "summary", sweep, "--out",
+                           str(table)], capture_output=True, text=True, preexec_fn=limited,
+                          timeout=300)
+    assert done.returncode == 3, done.stderr
+    err = done.stderr.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("loopsim: error:") and "too large" in err[0], err
+    assert listing_of(table.parent) == []
 
 
 @pytest.mark.parametrize("command", ["summary", "figures"])

@@ -132,6 +132,29 @@ def test_report_parses_its_images_decode_and_its_numbers_are_the_summarys(sweep,
     assert "CPUs" in provenance["machine"]
 
 
+def test_steady_is_unknown_for_a_sweep_without_early_stop(sweep, tmp_path, capsys):
+    """Issue 46.4: the fixture's sweep ran with --no-early-stop, so no run was tested for a
+    steady state: ``steady`` is unknown (empty), not 0, in summarize, ``loopsim summary``
+    (printed and written) and the report."""
+    out, frame = sweep
+    assert frame.attrs["loopsim"]["sweep_config"]["early_stop"] is False
+    cells = summary.summarize(frame)
+    assert cells["steady"].isna().all() and cells["seeds"].notna().all()
+    table = tmp_path / "cells.parquet"
+    assert main(["summary", out, "--out", str(table)]) == 0
+    printed = capsys.readouterr().out.splitlines()
+    steady = printed[0].split().index("steady")
+    assert all(line.split()[steady] == "<NA>" for line in printed[1:5]), printed
+    import pandas as pd
+
+    assert pd.read_parquet(table)["steady"].isna().all()
+    target = tmp_path / "report.html"
+    assert main(["report", out, "--out", str(target)]) == 0
+    rows = parse(target)[0].tables["cells"]
+    column = rows[0].index("steady")
+    assert [r[column] for r in rows[1:]] == [""] * 4
+
+
 def test_report_of_a_seeds_auto_directory_shows_the_distributions(tmp_path):
     from loopsim import seeding
     from loopsim.sweeps.seeds_auto import run_seeds_auto

@@ -4,7 +4,7 @@ import pandas as pd
 import pytest
 
 from loopsim import seeding
-from loopsim.seeding import CAP, CONTINUE, DETERMINISTIC, SHARP, SeedTargets
+from loopsim.seeding import CAP, CONTINUE, DETERMINISTIC, FAILED, SHARP, SeedTargets
 
 
 def cell(regimes, tilts, aspects=None):
@@ -36,6 +36,20 @@ def test_one_seed_apart_is_not_deterministic(change):
         regimes[0], tilts[0], aspects[0] = "failed", np.nan, np.nan
     reason, wanted = seeding.decide(cell(regimes, tilts, aspects), targets)
     assert (reason, wanted) == (CONTINUE, 8)
+
+
+def test_a_cell_whose_every_seed_failed_stops_as_failed_and_is_no_sample():
+    """Issue 46.2: no successful run, no distribution: the cell stops after its first round
+    (it went on to the cap), and its runs are not samples even though no failed run is
+    "determined" (they were, so its later seeds dropped their twins and it was checked)."""
+    rows = cell(["failed"] * 4, np.full(4, np.nan), np.full(4, np.nan)).assign(
+        determined=False)
+    assert seeding.decide(rows, SeedTargets()) == (FAILED, 4)
+    assert seeding.decide(rows.iloc[:2], SeedTargets()) == (CONTINUE, 4)  # first round first
+    assert not seeding.runs_are_samples(rows)
+    one_ok = rows.assign(regime=["failed"] * 3 + ["3d"])
+    assert seeding.decide(one_ok, SeedTargets())[0] == CONTINUE
+    assert seeding.runs_are_samples(one_ok)
 
 
 def test_a_spread_cell_doubles_until_sharp():

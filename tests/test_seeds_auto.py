@@ -222,6 +222,55 @@ def test_sampled_cells_drop_their_twins_and_are_checked_in_distribution():
     assert settled["check_verdict"] == "" and np.isnan(settled["check_tilt_ks_p"])
 
 
+def test_a_cell_whose_every_seed_fails_stops_as_failed_without_a_check(tmp_path):
+    """Issue 46.2: a step budget of 3 fails every run (and every twin) at once.  The cell
+    used to be taken for samples (no failed run is "determined"): 4 more seeds without
+    twins and 4 check runs, and the verdict "indistinguishable" for failures against
+    failures.  It stops after its first round, twins kept, with no check and no verdict."""
+    config = sweeps.SweepConfig(cases=cells([60.0], [30.0]), t_end=0.2, method="rkf45",
+                                twin=True, chunk_size=2, max_steps=3)
+    targets = seeding.SeedTargets(max_seeds=8)
+    calls = []
+    out = tmp_path / "auto"
+    rows, stops = run_seeds_auto(config, str(out), targets, run_round=runner(calls))
+    assert calls == [4] and set(rows["regime"]) == {"failed"}
+    assert rows["twin_nfev"].gt(0).all()  # every seed kept its twin
+    stop = stops.iloc[0]
+    assert (stop["stop_reason"], stop["seeds"], stop["runs"]) == (seeding.FAILED, 4, "none")
+    assert (stop["check_seeds"], stop["check_verdict"]) == (0, "")
+    assert not (out / io.CHECK_DIR).exists()
+
+
+def test_check_seeds_0_says_the_later_seeds_ran_with_twins(tmp_path, capsys, monkeypatch):
+    """Issue 46.8: with --check-seeds 0 a sampled cell keeps its twins; the closing line
+    said its later seeds ran without.  Twins that never agree (as in the test below) make
+    the cell's runs samples, and a tilt tolerance below the seeds' spread runs it to the
+    cap."""
+    from loopsim.cli import main
+    from loopsim.outcomes import Thresholds
+
+    real = sweeps.run_seeds_auto
+
+    def sampled(config, out, targets, **kwargs):
+        strict = Thresholds(determined_tilt_deg=1e-15, determined_aspect=1e-15)
+        return real(dataclasses.replace(config, thresholds=strict), out,
+                    dataclasses.replace(targets, tilt_tol_deg=1e-12), **kwargs)
+
+    monkeypatch.setattr(sweeps, "run_seeds_auto", sampled)
+    out = tmp_path / "auto"
+    assert main(["sweep", "--g0", "60", "--theta0", "30", "--n", "4", "--method", "rkf45",
+                 "--t-end", "0.3", "--seeds", "auto", "--min-seeds", "2", "--max-seeds", "4",
+                 "--p-halfwidth", "0.01", "--check-seeds", "0", "--threads", "1", "--quiet",
+                 "--out", str(out)]) == 0
+    printed = capsys.readouterr().out
+    rows = loopsim.read_results(str(out))
+    assert len(rows) == 4 and rows["twin_nfev"].gt(0).all()  # the later seeds had twins
+    assert io.read_stop_table(str(out))["runs"].tolist() == ["samples"]
+    line = next(line for line in printed.splitlines() if "runs are samples" in line)
+    assert "ran with twins" in line and "without twins" not in line, line
+    assert "not checked (--check-seeds 0)" in line, line
+
+
 def test_a_sampled_cell_end_to_end(tmp_path):
     """Twins that can never agree (determined_tilt_deg 1e-15) make every run a sample:
     round 0 runs twins, round 1 none, and the check runs the untwinned seeds at 10x

@@ -62,6 +62,11 @@ def test_summarize_groups_seeds_into_cells():
     assert hot["tilt_median_low"] <= 23.5 <= hot["tilt_median_high"]
     assert hot["nfev"] == 800 and hot["wall_s"] == 4.0
     assert stable["steady"] == 8 and hot["steady"] == 7  # seed 5 still moving at t_end
+    frame = pd.DataFrame(rows)
+    frame.attrs["loopsim"] = dict(sweep_config=dict(early_stop=False))  # --no-early-stop
+    assert summary.summarize(frame)["steady"].isna().all()  # unknown, not 0 (issue 46.4)
+    frame.attrs["loopsim"] = dict(sweep_config=dict(early_stop=True))
+    assert summary.summarize(frame)["steady"].tolist() == [8, 7]
     with pytest.raises(ValueError, match="no column"):
         summary.summarize(pd.DataFrame(rows), by=["colour"])
 

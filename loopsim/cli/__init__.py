@@ -2,7 +2,8 @@
 
 Errors in the input end with one line ``loopsim: error: ...`` on stderr and
 exit status 2; a run that fails numerically exits 1 after printing its summary; the
-machine refusing to go on (disk full, read-only filesystem, I/O error) exits 3
+machine refusing to go on (disk full, read-only filesystem, I/O error, a file-size
+limit) exits 3
 (``common.EXIT_CODES``; docs/cli.md is generated from these parsers by
 scripts/cli_reference.py).
 

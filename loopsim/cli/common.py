@@ -27,7 +27,8 @@ EXIT_CODES = (
                       "says why)"),
     (EXIT_USAGE, "bad input: one line 'loopsim: error: ...' on stderr, nothing written"),
     (EXIT_ENVIRONMENT, "the machine's fault: disk full, read-only filesystem, I/O error, "
-                       "no memory or file handles left (re-run once fixed: sweeps resume)"),
+                       "no memory or file handles left, a file-size limit reached (re-run "
+                       "once fixed: sweeps resume)"),
     (130, "stopped by SIGINT (Ctrl-C: a sweep keeps its finished cases)"),
     (143, "stopped by SIGTERM (as 130)"),
 )
@@ -146,9 +147,10 @@ def interrupted(signum, detail):
     if _is_program():
         sys.stdout.flush()
         sys.stderr.flush()
-        from .._signals import end_children
+        from .._signals import end_children, remove_temporaries
 
         end_children()
+        remove_temporaries()
         os._exit(status)
     return status
 

@@ -2,7 +2,6 @@
 printed and its snapshots optionally written."""
 import argparse
 import json
-import os
 import sys
 
 from ..config import DEFAULT_N, DEFAULT_SEED
@@ -126,7 +125,6 @@ def _run(args):
     _check_run_sizes(args)
     if args.out is not None:
         validation.check_output_file("--out", args.out)
-        io.remove_stale_temporaries(os.path.dirname(os.path.abspath(args.out)))
     g0, start, info = args.g0, None, None
     if args.initial is not None:
         start, info, g0 = _load_initial_for_run(args)

@@ -12,7 +12,8 @@ def add_parser(commands):
         "ratio medians, with 95%% intervals",
         description="Summarise a sweep over its seeds: per cell (g0, theta0 and every other "
         "swept input), the number of seeds, resolved, determined and steady rows (steady: "
-        "a terminal state reached before --t-end), each regime's "
+        "a terminal state reached before --t-end; empty, unknown, for a sweep run with "
+        "--no-early-stop), each regime's "
         "probability with its Wilson interval, the median and quartiles of the terminal "
         "tilt and aspect ratio with bootstrap intervals of the medians, and the cost "
         "(loopsim/summary.py).",

@@ -229,6 +229,24 @@ def _check_rerun_options(args):
                          f"{', '.join('--' + k for k in RERUN_OPTIONS)} change)")
 
 
+def _sampled_cells_text(sampled, config, targets, out):
+    """What happened to the cells whose runs are samples (rows of the stop table), for the
+    closing line: their later seeds without twins and the check's verdicts, or, with
+    ``--check-seeds 0`` or ``--no-twin``, what ran instead."""
+    if not config.twin:
+        return "no twins and no distribution check (--no-twin)"
+    if targets.check_seeds == 0:
+        return ("their later seeds ran with twins, and their distributions were not checked "
+                "(--check-seeds 0)")
+    checked = sampled[sampled["check_seeds"] > 0]
+    verdicts = ", ".join(f"{k} {v}" for k, v in
+                         sorted(checked["check_verdict"].value_counts().items()))
+    check = (f"; their distributions checked against up to "
+             f"{int(checked['check_seeds'].max())} seeds each at 10x stricter "
+             f"tolerances ({out}/check): {verdicts}") if len(checked) else ""
+    return f"their later seeds ran without twins{check}"
+
+
 def command(args):
     import numba
 
@@ -282,7 +300,7 @@ def command(args):
                 if hasattr(stopped, "done") else "")
         return interrupted(getattr(stopped, "signum", 2),
                             f"{done}re-run the same command to resume")
-    from .. import summary
+    from .. import seeding, summary
 
     counts = summary.outcome_counts(frame)
     print(f"{counts['cases']} cases in {out}: "
@@ -309,15 +327,14 @@ def command(args):
             + f" (seeds per point {stopped['seeds_min']}-{stopped['seeds_max']}; why each "
             f"stopped: {out}/seeds_auto.parquet; per point: loopsim summary {out})")
         sampled = stops[stops["runs"] == "samples"] if "runs" in stops else stops.iloc[:0]
-        checked = sampled[sampled["check_seeds"] > 0]
         if len(sampled):
-            verdicts = ", ".join(f"{k} {v}" for k, v in
-                                 sorted(checked["check_verdict"].value_counts().items()))
-            check = (f"; their distributions checked against up to "
-                     f"{int(checked['check_seeds'].max())} seeds each at 10x stricter "
-                     f"tolerances ({out}/check): {verdicts}") if len(checked) else ""
             print(f"{len(sampled)} points' runs are samples (seeds in several regimes, or a "
-                  f"twin ending elsewhere): their later seeds ran without twins{check}")
+                  "twin ending elsewhere): " + _sampled_cells_text(sampled, config, targets,
+                                                                   out))
+        failed = stopped["reasons"].get(seeding.FAILED, 0)
+        if failed:
+            print(f"{failed} points with no successful seed (stop reason failed): no "
+                  "distribution, no check")
     if args.figure:
         use_agg()
         if seeds_auto:

@@ -18,9 +18,10 @@ FIGURE_NAMES = ("stability", "gallery", "phase", "q_tilt", "aspect", "phase_n", 
 
 
 def read_run(path):
-    """(trajectory DataFrame, summary dict) of a ``loopsim run --out`` file."""
-    import pyarrow.parquet as pq
-
+    """(trajectory DataFrame, summary dict) of a ``loopsim run --out`` file, read as sweep
+    chunks are (``io.read_table_checked``: page checksums and content hash verified).
+    ValueError, one line: a file that is not a run file, cannot be read, or is damaged
+    (``'PATH' is damaged (...)``)."""
     from .. import io
 
     try:
@@ -28,7 +29,9 @@ def read_run(path):
         if "summary" not in meta:
             raise ValueError(f"{path!r} is not a run file (written by 'loopsim run --out'): "
                              "no run summary in its metadata")
-        frame = pq.read_table(path).to_pandas()
+        frame = io.read_table_checked(path).to_pandas()
+    except io.DamagedFile as exc:
+        raise ValueError(f"{exc}; run it again (loopsim run --out)") from None
     except (OSError, ValueError) as exc:
         raise ValueError(f"cannot read {path!r}: {str(exc).splitlines()[0]}") from None
     missing = {"t", "x", "multiplier"} - set(frame.columns)

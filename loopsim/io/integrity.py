@@ -1,6 +1,8 @@
 """Files written whole or not at all, and read back verified: temporaries named for their
-process (and removed once it has died), atomic writes with Parquet page checksums and a
-content hash, and the checked reader that raises :class:`DamagedFile`."""
+process (removed by the next write into their directory once it has died, and by the
+process itself when a signal ends it at once: ``loopsim._signals``), atomic writes with
+Parquet page checksums and a content hash, and the checked reader that raises
+:class:`DamagedFile`."""
 import glob
 import hashlib
 import json
@@ -12,6 +14,8 @@ import tempfile
 import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
+
+from .._signals import track_temporary, untrack_temporary
 
 
 #: Temporary files are named .tmp-HOST-PID-*: only their owner, or a later process on the
@@ -58,31 +62,35 @@ def _umask():
 
 def _temporary(directory, suffix):
     """(fd, path) of a new temporary file in ``directory`` named for this host and process,
-    with the mode an ordinary ``open`` gives (0666 less the umask; mkstemp's is 0600).
-    The directory is made if absent (output paths are checked before any work)."""
+    with the mode an ordinary ``open`` gives (0666 less the umask; mkstemp's is 0600),
+    registered for removal should a signal end the process at once
+    (``_signals.remove_temporaries``).  The directory is made if absent (output paths are
+    checked before any work); the temporaries that dead processes left in it are removed
+    first (:func:`remove_stale_temporaries`)."""
     os.makedirs(directory, exist_ok=True)
+    remove_stale_temporaries(directory)
     fd, tmp = tempfile.mkstemp(prefix=_temporary_prefix(), suffix=suffix, dir=directory)
+    track_temporary(tmp)
     os.fchmod(fd, 0o666 & ~_umask())
     return fd, tmp
 
 
 def write_json_atomically(data, path):
-    """Write JSON to a temporary file in the target directory, then rename into place."""
-    fd, tmp = _temporary(os.path.dirname(os.path.abspath(path)), ".json")
-    try:
-        with os.fdopen(fd, "w") as handle:
+    """Write JSON to a temporary file in the target directory, then rename into place
+    (:func:`write_file_atomically`)."""
+    def write(tmp):
+        with open(tmp, "w") as handle:
             json.dump(data, handle, indent=1)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-        raise
+
+    write_file_atomically(path, write)
 
 
 def write_file_atomically(path, write):
     """Call ``write(temporary_path)`` on a temporary file named for this process in the
     target directory (with the target's extension), then rename it into place: a file
-    is there whole or not at all (a full disk leaves no empty or partial file)."""
+    is there whole or not at all (a full disk leaves no empty or partial file, an
+    exception or a signal no temporary; the temporaries of dead processes in that
+    directory are removed first)."""
     fd, tmp = _temporary(os.path.dirname(os.path.abspath(path)), os.path.splitext(path)[1])
     os.close(fd)
     try:
@@ -92,6 +100,8 @@ def write_file_atomically(path, write):
         if os.path.exists(tmp):
             os.remove(tmp)
         raise
+    finally:
+        untrack_temporary(tmp)
 
 
 def write_table_atomically(table, path):
@@ -101,15 +111,8 @@ def write_table_atomically(table, path):
     meta = {_text(k): _text(v) for k, v in (table.schema.metadata or {}).items()
             if _text(k) != CONTENT_KEY}
     table = table.replace_schema_metadata(dict(meta, **{CONTENT_KEY: content_hash(table, meta)}))
-    fd, tmp = _temporary(os.path.dirname(os.path.abspath(path)), ".parquet")
-    os.close(fd)
-    try:
-        pq.write_table(table, tmp, write_page_checksum=True)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-        raise
+    write_file_atomically(path, lambda tmp: pq.write_table(table, tmp,
+                                                          write_page_checksum=True))
 
 
 # ---- checksums: detecting damaged files -------------------------------------------------

@@ -2,6 +2,7 @@
 Parquet), and the checks a configuration passes before any work."""
 import dataclasses
 import itertools
+import json
 import math
 import os
 import re
@@ -9,7 +10,7 @@ import re
 import numpy as np
 import pandas as pd
 
-from .. import integrators, models, refinement, shapes, validation
+from .. import integrators, io, models, refinement, shapes, validation
 from ..config import (
     DEFAULT_ATOL, DEFAULT_CHUNK_SIZE, DEFAULT_LENGTH_TOL, DEFAULT_MAX_STEPS, DEFAULT_N_MAX,
     MODEL_CHOICES,
@@ -195,7 +196,8 @@ def read_cases_file(path, perturbation=DEFAULT_PERTURBATION, n=6, auto_top=None)
             parquet = pq.ParquetFile(path)
             rows = parquet.metadata.num_rows
             names = parquet.schema_arrow.names
-            frame = None if rows > limit else pd.read_parquet(path)
+            # checked as loopsim's own files are (a table loopsim wrote carries checksums)
+            frame = None if rows > limit else io.read_table_checked(path).to_pandas()
         else:
             frame = pd.read_csv(path, nrows=limit + 1)
             rows, names = len(frame), list(frame.columns)
@@ -231,7 +233,42 @@ def read_cases_file(path, perturbation=DEFAULT_PERTURBATION, n=6, auto_top=None)
                     "perturbation" in given and bool(given["perturbation"].iloc[i]))
             except ValueError as exc:
                 raise ValueError(f"cases file row {i}: {exc}") from None
+    repeat = repeated_case(cases)
+    if repeat is not None:
+        first, second = repeat
+        raise ValueError(f"cases file {path!r} holds one case twice: rows {first} and {second} "
+                         f"(counted from 0: {describe_case(cases[first])}); a sweep runs each "
+                         "case once, remove one of them")
     return cases
+
+
+def describe_case(case):
+    """A case's inputs as one line: 'g0=10, theta0_deg=30, n=6, seed=0, ...'."""
+    return ", ".join(f"{key}={value:g}" if isinstance(value, float) else f"{key}={value}"
+                     for key, value in case.items())
+
+
+def _case_key(values):
+    """A hashable key of a case's values (its items; as JSON where a value is not
+    hashable)."""
+    try:
+        return frozenset(values.items())
+    except TypeError:
+        return json.dumps(values, sort_keys=True, default=str)
+
+
+def repeated_case(cases, config=None):
+    """(i, j), i < j, of the first case ``j`` that repeats an earlier case ``i`` (the same
+    inputs; with ``config``, a per-case override equal to the sweep's option is the same
+    as none, as :func:`case_option` reads it), or None where every case is distinct."""
+    options = {} if config is None else {key: getattr(config, key) for key in CASE_OVERRIDES}
+    seen = {}
+    for index, case in enumerate(cases):
+        key = _case_key({**options, **case})
+        if key in seen:
+            return seen[key], index
+        seen[key] = index
+    return None
 
 
 def validate(config):
@@ -264,6 +301,11 @@ def validate(config):
                                "n_start" if config.n_auto else "n")
         except ValueError as exc:
             raise ValueError(f"case {case_id}: {exc}") from None
+    repeat = repeated_case(config.cases, config)
+    if repeat is not None:
+        raise ValueError(f"cases {repeat[0]} and {repeat[1]} are one case twice "
+                         f"({describe_case(config.cases[repeat[0]])}); a sweep runs each case "
+                         "once (a value given twice in --g0, --theta0 or --n?)")
     if config.slenderness is not None and not any(
             case_option(config, case, "model") == "nonlocal" for case in config.cases):
         raise ValueError(f"slenderness applies only to the nonlocal model, got slenderness="

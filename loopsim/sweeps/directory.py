@@ -77,12 +77,10 @@ def repair_directory(out, files, stored):
 def _remove_contained(out, files, count):
     """Remove result files (and their snapshots) whose positions another file holds too,
     once that file's rows are checked to be the cases its name says."""
-    import pyarrow.parquet as pq
-
     widest = None
     for start, stop in sorted(files, key=lambda key: (key[0], -key[1])):
         if widest is not None and start >= widest[0] and stop <= widest[1]:
-            ids = pq.read_table(files[widest], columns=["case_id"]).column("case_id")
+            ids = io.read_table_checked(files[widest]).column("case_id")
             io.check_rows(files[widest], widest, ids.to_pylist(), count)
             name = os.path.basename(files[start, stop])
             for path in (os.path.join(out, io.SNAPSHOT_DIR, name), files[start, stop]):

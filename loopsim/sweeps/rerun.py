@@ -99,8 +99,6 @@ def _merge_rerun(out, fingerprint, directory, attempt, rows):
     """Put the rerun ``rows`` (case ids of the sweep) into the result files holding those
     cases; a file already carrying ``attempt`` in its metadata is done (so a merge cut
     short by a kill resumes)."""
-    import pyarrow.parquet as pq
-
     replaced = os.path.join(directory, "replaced")
     os.makedirs(replaced, exist_ok=True)
     new = pa.Table.from_pandas(rows, schema=io.RESULT_SCHEMA, preserve_index=False)
@@ -109,13 +107,12 @@ def _merge_rerun(out, fingerprint, directory, attempt, rows):
         meta = io.read_metadata(path)
         if attempt in meta.get("reruns", []):
             continue
-        table = io.result_table(io.read_table_checked(path, io.requires_hash(
-            io.read_sweep_file(out))))
+        written = io.read_table_checked(path, io.requires_hash(io.read_sweep_file(out)))
+        table = io.result_table(written)
         mask = [i in by_id for i in table.column("case_id").to_pylist()]
         if not any(mask):
             continue
-        io.write_table_atomically(pq.read_table(path),
-                                  os.path.join(replaced, os.path.basename(path)))
+        io.write_table_atomically(written, os.path.join(replaced, os.path.basename(path)))
         keep = table.filter(pa.array([not m for m in mask]))
         ids = set(table.column("case_id").to_pylist())
         fresh = new.filter(pa.array([i in ids for i in new.column("case_id").to_pylist()]))

@@ -3,7 +3,7 @@
 The directory (``io.seedsdir``) holds the cells, the targets and the sweep's other
 options, one ordinary sweep directory per round (checksummed, resumable) and, once every
 cell has stopped, the stop table: one row per cell saying why it stopped
-(``seeding``: deterministic, sharp or cap).  Round r's cases are planned from the rows of
+(``seeding``: failed, deterministic, sharp or cap).  Round r's cases are planned from the rows of
 rounds < r only, by ``seeding.decide``; those rows are reproducible bit for bit, so
 re-running the command after an interruption plans the same rounds and resumes the one
 it stopped in.  Each round's configuration fingerprint is recorded in the directory's
@@ -208,18 +208,26 @@ CHECK_COLUMNS = {"seeds_b": "check_seeds", "verdict": "check_verdict",
                  "regime_p": "check_regime_p", "tilt_wasserstein": "check_tilt_wasserstein"}
 
 
+def _runs(rows):
+    """How a cell's answer was decided: "none" (no run succeeded), "samples"
+    (``seeding.runs_are_samples``) or "trajectories"."""
+    if not seeding.any_succeeded(rows):
+        return "none"
+    return "samples" if seeding.runs_are_samples(rows) else "trajectories"
+
+
 def stop_table(cells, rows, targets, checks=None):
     """One row per cell: its inputs, seeds, rounds, stop reason and interval half-widths;
     how its answer was decided (``runs``: "trajectories", each twin-checked or
-    deterministic, or "samples"; ``twins``: rows with a twin) and, for sampled cells, the
+    deterministic, "samples", or "none" where every run failed; ``twins``: rows with a
+    twin) and, for sampled cells, the
     distribution check against its stricter sample (``check_seeds`` of them: its twins and
     its check runs, ``checks``; :func:`stricter_sample`)."""
     groups = _groups(rows)
     table = pd.DataFrame([
         dict(seeding.cell_record(CELL_KEYS, cell_key(cell), groups[cell_key(cell)], targets,
                                  int(groups[cell_key(cell)]["round"].max()) + 1),
-             runs="samples" if seeding.runs_are_samples(groups[cell_key(cell)])
-             else "trajectories",
+             runs=_runs(groups[cell_key(cell)]),
              twins=int(groups[cell_key(cell)]["determined"].notna().sum()))
         for cell in cells])
     empty = dict(check_seeds=0, check_verdict="", **{
@@ -257,9 +265,7 @@ def run_seeds_auto(config, out, targets, *, run_round, command_line=None, announ
     """
     targets.check()
     cells = [dict(case, seed=0) for case in config.cases]
-    validate(dataclasses.replace(config, cases=cells))
-    if len({cell_key(c) for c in cells}) != len(cells):
-        raise ValueError("--seeds auto needs distinct cells (g0, theta0, n, perturbation)")
+    validate(dataclasses.replace(config, cases=cells))  # distinct cells among the rest
     check_size(cells, targets)
     made = prepare(out, config, targets, command_line)
     if not made and os.path.isfile(os.path.join(out, io.STOPS_FILE)):

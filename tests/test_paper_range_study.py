@@ -1,0 +1,85 @@
+"""scripts/paper_range_study.py (issue 46): ``--quick`` keeps to a folder of its own and
+never writes over the committed study; ``--read-only`` before any part has finished is
+one line; the printout counts a cell whose ``steady`` is unknown apart."""
+import hashlib
+import os
+import runpy
+import shutil
+import subprocess
+import sys
+
+import pandas as pd
+import pytest
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SCRIPT = os.path.join(ROOT, "scripts", "paper_range_study.py")
+COMMITTED = [os.path.join(ROOT, "data", "paper_range_summary.parquet"),
+             os.path.join(ROOT, "data", "paper_range_stops.parquet"),
+             os.path.join(ROOT, "docs", "figures", "paper_range.png")]
+
+
+def study():
+    return runpy.run_path(SCRIPT)
+
+
+def digests(paths):
+    return [hashlib.sha256(open(p, "rb").read()).hexdigest() for p in paths]
+
+
+def test_quick_writes_under_its_own_folder_by_default(monkeypatch):
+    """Issue 46.3: --quick wrote data/paper_range_*.parquet and docs/figures/paper_range.png,
+    the committed study, with exit 0 and no warning."""
+    monkeypatch.chdir(ROOT)
+    args = study()["parse_args"](["--quick"])
+    quick = os.path.join("runs", "paper_range_quick")
+    assert (args.runs, args.data, args.figure) == (
+        quick, quick, os.path.join(quick, "paper_range.png"))
+    full = study()["parse_args"]([])
+    assert (full.runs, full.data, full.figure) == (
+        "runs", "data", os.path.join("docs", "figures", "paper_range.png"))
+
+
+def test_quick_refuses_to_write_over_the_committed_study(tmp_path, monkeypatch):
+    """Run where a checkout's committed files lie (here copies of them, so that the test
+    cannot damage the repository's own should the refusal ever fail): --quick pointed at
+    them is one line, exit 2, before any sweep; the repository's own are refused too."""
+    work = tmp_path / "checkout"
+    copies = [str(work / os.path.relpath(p, ROOT)) for p in COMMITTED]
+    for path, copy in zip(COMMITTED, copies):
+        os.makedirs(os.path.dirname(copy), exist_ok=True)
+        shutil.copy(path, copy)
+    before = digests(copies)
+    for given in (["--data", "data"], ["--figure", os.path.join("docs", "figures",
+                                                                "paper_range.png")]):
+        done = subprocess.run([sys.executable, SCRIPT, "--quick", "--runs", str(tmp_path / "r"),
+                               *given], cwd=work, capture_output=True, text=True, timeout=600)
+        assert done.returncode == 2, (given, done.stderr)
+        err = done.stderr.strip().splitlines()
+        assert len(err) == 1 and "committed study" in err[0] and "Traceback" not in done.stderr
+        assert not (tmp_path / "r").exists()  # refused before any sweep
+    assert digests(copies) == before
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(ValueError, match="committed study"):
+        study()["parse_args"](["--quick", "--data", os.path.join(ROOT, "data")])
+
+
+def test_read_only_with_no_finished_part_is_one_line(tmp_path):
+    """Issue 46.9: it ended in a traceback (pandas' "No objects to concatenate")."""
+    done = subprocess.run([sys.executable, SCRIPT, "--read-only", "--runs", str(tmp_path / "r"),
+                           "--data", str(tmp_path / "d"), "--figure", str(tmp_path / "f.png")],
+                          capture_output=True, text=True, timeout=300)
+    assert done.returncode != 0
+    err = done.stderr.strip().splitlines()
+    assert len(err) == 1 and "no part has finished" in err[0], done.stderr
+    assert sorted(os.listdir(tmp_path)) == []  # nothing written
+
+
+def test_the_printout_counts_unknown_steady_cells_apart():
+    """Issue 46.4: a cell run with --no-early-stop has steady <NA> (unknown), never "all
+    seeds moving"."""
+    table = pd.DataFrame(dict(g0=[10.0, 60.0, 150.0], theta0_deg=30.0, seeds=[4, 4, 8],
+                              steady=pd.array([4, 3, pd.NA], dtype="Int64")))
+    lines = study()["steady_lines"](table)
+    assert lines[0].endswith("1; runs not steady: 1 of 8"), lines
+    assert lines[1] == "  (60.0, 30°): 1 of 4"
+    assert lines[2].endswith("unknown (run with --no-early-stop: no run tested): 1")
