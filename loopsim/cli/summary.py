@@ -1,5 +1,6 @@
 """``loopsim summary``: one row per cell of a sweep (regime probabilities, medians, with
 intervals), printed and optionally written and drawn."""
+from ..shapes.circle import PERTURBATION_ENSEMBLE
 from .common import (
     HelpFormatter, directory_name, print_and_write, save_distribution_figure,
 )
@@ -48,7 +49,8 @@ def command(args):
         "p_stable", "p_in_plane", "p_3d", "p_3d_low", "p_3d_high",
         "tilt_median", "tilt_median_low", "tilt_median_high"]
     print_and_write(table, args.out, dict(table.attrs["loopsim_summary"],
-                                           summary_of=directory_name(args.sweep_dir)),
+                                           summary_of=directory_name(args.sweep_dir),
+                                           perturbation_ensemble=PERTURBATION_ENSEMBLE),
                     shown, declarations=columns.SUMMARY_COLUMNS)
     if args.figure is not None:
         save_distribution_figure(table, frame, args.figure)

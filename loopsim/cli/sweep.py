@@ -3,6 +3,7 @@ when re-run; also reruns of a sweep's failed cases (``--rerun-failed``)."""
 import math
 import sys
 
+from ..shapes.circle import PERTURBATION_ENSEMBLE
 from ..config import DEFAULT_AUTO_CHUNK_SIZE, DEFAULT_CHUNK_SIZE, DEFAULT_N, SEED_TARGETS
 from .common import (
     EXIT_FAILED_RUN, HelpFormatter, Parser, add_integration_options, check_auto_options,
@@ -54,7 +55,9 @@ def add_parser(commands):
                       "scheme: --n 6 --method rkf45)")
     grid.add_argument("--seeds", default="1", metavar="K|auto",
                       help="seeds 0..K-1 per point, or auto: per point 4, 8, 16 ... seeds "
-                      "until its answer is sharp (see --p-halfwidth; docs/distributions.md)")
+                      "until its answer is sharp (see --p-halfwidth; docs/distributions.md). "
+                      "Probabilities over seeds are over this ensemble: "
+                      + PERTURBATION_ENSEMBLE)
     grid.add_argument("--cases", metavar="FILE", help="CSV/Parquet with columns g0, theta0_deg "
                       "[, n, seed, perturbation, initial, initial_case_id] instead of a grid "
                       "(initial: a point file or results per row, paths relative to FILE; "
