@@ -22,9 +22,10 @@ Internals, each layer importing only those above it: ``config``, ``validation``,
 ``shapes``, ``stability``; ``io``; ``result``, ``api``, ``sweeps``, ``summary``, ``figures``,
 ``cli``.
 """
-from . import _signals
+from . import _moved, _signals
 
 _signals.install_early()  # the loopsim program: Ctrl-C while loading is one line, exit 130
+_moved.install()  # the old paths of renamed modules, for one release (CHANGELOG.md)
 
 from ._version import __version__  # noqa: E402
 
@@ -33,8 +34,9 @@ from ._version import __version__  # noqa: E402
 _EXPORTS = {
     "simulate": "api", "SimulationResult": "api", "evaluate_maps": "api",
     "SUMMARY_FIELDS": "api", "LoopsimWarning": "api", "stability_parameter": "diagnostics",
-    "coefficients": "io", "read_results": "io", "read_snapshots": "io", "sweep": "sweeps",
-    "summarize": "summary", "compare": "summary",
+    "coefficients": "storage", "read_results": "storage", "read_snapshots": "storage",
+    "sweep": "sweeps",
+    "summarize": "outcome_statistics", "compare": "outcome_statistics",
     "animate": "figures.animation", "report": "sweep_report",
 }
 __all__ = list(_EXPORTS) + ["__version__"]

@@ -11,9 +11,9 @@ import warnings
 
 import numpy as np
 
-from . import _jitcache, diagnostics, integrators, io, models, outcomes, refinement, shapes, \
+from . import _jitcache, diagnostics, integrators, storage, models, outcomes, refinement, shapes, \
     validation
-from .config import (
+from .defaults import (
     DEFAULT_ATOL, DEFAULT_LENGTH_TOL, DEFAULT_MAX_STEPS, DEFAULT_N_MAX, DEFAULT_RTOL,
     DEFAULT_SEED, DEFAULT_STEADY_INTERVAL, DEFAULT_T_END, DEFAULT_TAIL_TOL, DEFAULT_W,
 )
@@ -131,7 +131,7 @@ def simulate(
         required unless ``initial`` is given (then None: the tilt is measured).
     n : int or "auto", default "auto"
         Fourier truncation order (1..128), or "auto": start at ``n_start`` and restart
-        the run from t0 at the next order of ``config.AUTO_ORDERS`` (up to ``n_max``)
+        the run from t0 at the next order of ``defaults.AUTO_ORDERS`` (up to ``n_max``)
         whenever its spectral tail passes ``tail_tol`` (``loopsim.refinement``).
     t_span : (float, float), default (0.0, 10.0)
         Start and end time, in t_u.
@@ -170,7 +170,7 @@ def simulate(
         in L/2π, a point file (CSV/Parquet, columns x, y, z; fitted by arc length and
         scaled to length 2π) or results (a ``run --out`` file, a sweep directory).  With
         ``n="auto"`` a point file starts at the lowest order whose truncation of the fit
-        leaves out at most ``config.INITIAL_CONTENT_TOL`` (1e-12) of its RMS amplitude
+        leaves out at most ``defaults.INITIAL_CONTENT_TOL`` (1e-12) of its RMS amplitude
         (at least 6, at most the ladder's top), coefficients and results at their own
         order; every order of the ladder starts from that same shape.
     initial_case_id : int or None, default None

@@ -1,6 +1,6 @@
 """Every column loopsim writes, declared once: its unit and what it means.
 
-The units are those of the dimensionless equations (``loopsim.config``; docs/model.md,
+The units are those of the dimensionless equations (``loopsim.defaults``; docs/model.md,
 "Units"): lengths in L/2π (the loop has length 2π), time in
 t_u = ζ⊥ (L/2π)⁴ / EI (ζ⊥ = 8πμ/c the perpendicular drag coefficient per unit length),
 forces (the axial force N, the multiplier T) in EI (2π/L)², force densities in
@@ -172,7 +172,7 @@ STOP_COLUMNS = {
     "seeds": (COUNT, "seeds run for the cell"),
     "rounds": (COUNT, "rounds the cell took part in"),
     "stop_reason": (TEXT, "why the cell stopped: deterministic, sharp or cap (--max-seeds reached) "
-                          "(loopsim.seeding)"),
+                          "(loopsim.seeds_auto_rule)"),
     "p_halfwidth": (PROBABILITY, "largest half-width of the regime shares' 95% Wilson "
                                  "intervals at the stop"),
     "tilt_halfwidth_deg": (DEG, "half-width of the median terminal tilt's 95% bootstrap "

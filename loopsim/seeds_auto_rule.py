@@ -15,7 +15,7 @@ A cell whose runs are *samples* (:func:`runs_are_samples`: its seeds end in diff
 regimes, or some run's stricter twin ends elsewhere) needs no more twins: each would only
 prove once more that one run is a sample.  Its later seeds run without twins, and its
 distribution is checked instead against a subsample at the twins' stricter tolerances
-(``check_seeds`` seeds, ``sweeps.seeds_auto``; verdict by ``summary.compare``).
+(``check_seeds`` seeds, ``sweeps.seeds_auto``; verdict by ``outcome_statistics.compare``).
 
 The rule reads only a cell's finished rows, which are reproducible bit for bit, so the
 rounds it plans are too: a resumed ``--seeds auto`` sweep plans what the interrupted one
@@ -27,9 +27,9 @@ import math
 
 import numpy as np
 
-from .config import SEED_TARGETS
+from .defaults import SEED_TARGETS
 from .outcomes import REGIMES
-from .summary import bootstrap_interval, wilson_interval
+from .outcome_statistics import bootstrap_interval, wilson_interval
 
 #: Why a cell stopped adding seeds (``stop_reason``); ``CONTINUE`` while it has not.
 DETERMINISTIC, SHARP, CAP, CONTINUE = "deterministic", "sharp", "cap", ""

@@ -32,7 +32,7 @@ import time
 import pandas as pd
 
 import loopsim
-from loopsim import columns, config, io, refinement, shapes, spectral, sweeps
+from loopsim import columns, defaults, refinement, shapes, spectral, storage, sweeps
 from loopsim.cli.common import directory_name, print_and_write, save_distribution_figure
 
 #: What the second step varies, and the tolerances of ``--check tolerance``.
@@ -62,10 +62,10 @@ def same_start_run(g0, theta0_deg, seed, n):
     its seeded perturbation at the ladder's first order, zero-padded exactly to ``n``),
     with the sweep's defaults and early stop, no twin: its summary row."""
     start = shapes.initial_shape(refinement.AUTO_START, math.radians(theta0_deg),
-                                 config.DEFAULT_PERTURBATION, seed)
+                                 defaults.DEFAULT_PERTURBATION, seed)
     result = loopsim.simulate(g0, None, initial=spectral.resize(start, n), n=n, method="auto",
-                              twin=False, steady_tol=config.DEFAULT_STEADY_TOL,
-                              steady_interval=config.DEFAULT_STEADY_INTERVAL)
+                              twin=False, steady_tol=defaults.DEFAULT_STEADY_TOL,
+                              steady_interval=defaults.DEFAULT_STEADY_INTERVAL)
     # the cell's inputs as given (the measured tilt differs from them by the perturbation)
     return dict(result.summary(), g0=g0, theta0_deg=theta0_deg, seed=seed, n=n)
 
@@ -156,7 +156,7 @@ def main():
     rows = loopsim.sweep(g0, theta0, auto_dir, n="auto", seeds="auto",
                          max_seeds=args.max_seeds, threads=args.threads, quiet=False)
     auto_s = time.perf_counter() - started
-    stops = io.read_stop_table(auto_dir)
+    stops = storage.read_stop_table(auto_dir)
     cells = loopsim.summarize(rows)
 
     started = time.perf_counter()

@@ -41,7 +41,7 @@ import sys
 import numpy as np
 import pandas as pd
 
-from loopsim import cli, columns, io, summary
+from loopsim import cli, columns, outcome_statistics, storage
 from loopsim.cli.common import print_and_write, save_distribution_figure
 
 #: The paper's grid: g0 = 10..350 in 15 values, θ0 = 6..90° in 15.
@@ -104,19 +104,19 @@ def main():
         path = os.path.join(args.runs, name)
         if not args.read_only:
             run_part(path, g0, theta0, args.threads, args.max_seeds, args.quick)
-        elif not os.path.isfile(os.path.join(path, io.STOPS_FILE)):
+        elif not os.path.isfile(os.path.join(path, storage.STOPS_FILE)):
             print(f"{name}: not finished, left out ({len(g0) * len(theta0)} cells)")
             continue
-        frames.append(io.read_seeds_auto(path).assign(part=name))
-        stops.append(io.read_stop_table(path).assign(part=name))
-        check = os.path.join(path, io.CHECK_DIR)
+        frames.append(storage.read_seeds_auto(path).assign(part=name))
+        stops.append(storage.read_stop_table(path).assign(part=name))
+        check = os.path.join(path, storage.CHECK_DIR)
         if os.path.isdir(check):
-            checks.append(io.read_results(check))
+            checks.append(storage.read_results(check))
     frame = pd.concat(frames, ignore_index=True)
     stop = pd.concat(stops, ignore_index=True).drop(columns="part")
     stop["n"] = stop["n"].astype("int64")
     check_rows = pd.concat(checks, ignore_index=True) if checks else pd.DataFrame()
-    table = summary.summarize(frame.drop(columns="part"))
+    table = outcome_statistics.summarize(frame.drop(columns="part"))
     os.makedirs(args.data, exist_ok=True)
     meta = dict(summary_of=" + ".join(sorted(set(frame["part"]))))
     shown = ["g0", "theta0_deg", "seeds", "determined", "p_stable", "p_in_plane", "p_3d",

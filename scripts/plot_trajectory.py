@@ -14,11 +14,11 @@ matplotlib.use("Agg")
 
 import pyarrow.parquet as pq  # noqa: E402
 
-from loopsim import figures, io  # noqa: E402
+from loopsim import figures, storage  # noqa: E402
 
 
 def main(path, figure):
-    summary = io.read_metadata(path)["summary"]
+    summary = storage.read_metadata(path)["summary"]
     title = f"g0 = {summary['g0']:g}, θ0 = {summary['theta0_deg']:g}°, n = {summary['n']}"
     fig = figures.trajectory(pq.read_table(path).to_pandas(), summary["n"], title)
     figures.save(fig, figure, dpi=150)

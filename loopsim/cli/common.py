@@ -6,7 +6,7 @@ import math
 import os
 import sys
 
-from ..config import (
+from ..defaults import (
     DEFAULT_ATOL, DEFAULT_N, DEFAULT_N_MAX, DEFAULT_PERTURBATION, DEFAULT_RTOL, DEFAULT_T_END,
     DEFAULT_TAIL_TOL, DEFAULT_W, MAX_SLENDERNESS, MODEL_CHOICES,
 )
@@ -168,15 +168,15 @@ def print_and_write(table, out, meta, shown=None, *, declarations):
     import pandas as pd
     import pyarrow as pa
 
-    from .. import io
+    from .. import storage
 
     with pd.option_context("display.width", 160, "display.max_columns", 40):
         print(table[shown or list(table.columns)].to_string(
             index=False, float_format=lambda v: f"{v:.4g}"))
     if out is not None:
-        io.write_table_atomically(io.described(
+        storage.write_table_atomically(storage.described(
             pa.Table.from_pandas(table, preserve_index=False)
-            .replace_schema_metadata(io.provenance(**meta)), declarations), out)
+            .replace_schema_metadata(storage.provenance(**meta)), declarations), out)
         print(f"table: {out}")
 
 

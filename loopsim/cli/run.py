@@ -5,7 +5,7 @@ import json
 import os
 import sys
 
-from ..config import DEFAULT_N, DEFAULT_SEED
+from ..defaults import DEFAULT_N, DEFAULT_SEED
 from .common import (
     EXIT_FAILED_RUN, HelpFormatter, add_integration_options, check_auto_options, interrupted,
     real,
@@ -121,12 +121,12 @@ def command(args):
 def _run(args):
     import functools
 
-    from .. import api, io, sweeps, validation
+    from .. import api, storage, sweeps, validation
 
     _check_run_sizes(args)
     if args.out is not None:
         validation.check_output_file("--out", args.out)
-        io.remove_stale_temporaries(os.path.dirname(os.path.abspath(args.out)))
+        storage.remove_stale_temporaries(os.path.dirname(os.path.abspath(args.out)))
     g0, start, info = args.g0, None, None
     if args.initial is not None:
         start, info, g0 = _load_initial_for_run(args)
@@ -152,12 +152,12 @@ def _run(args):
             info = dict(info, perturbation=summary["perturbation"])
             result.initial_info = info
         if args.out:  # a signal now waits for the (atomic) write to finish
-            table = io.trajectory_table(result, command_line=sys.argv)
+            table = storage.trajectory_table(result, command_line=sys.argv)
             if info is not None:  # the initial shape's diagnostics (scale, source)
                 meta = dict(table.schema.metadata or {})
                 meta[b"initial"] = json.dumps(info).encode()
                 table = table.replace_schema_metadata(meta)
-            io.write_table_atomically(table, args.out)
+            storage.write_table_atomically(table, args.out)
     summary["compile_s"] = result.compile_s
     if args.json:
         print(json.dumps(summary if info is None else dict(summary, initial=info)))

@@ -3,7 +3,7 @@ linearisation, or the paper's operator (``--paper``)."""
 import json
 import math
 
-from ..config import DEFAULT_W
+from ..defaults import DEFAULT_W
 from .common import HelpFormatter, add_model_options, real, use_agg
 
 
@@ -54,7 +54,7 @@ FULL_ONLY = ("n", "theta0", "w", "q_scan", "g0", "top", "onset", "figure", "slen
 
 def _cmd_stability_full(args):
     from .. import figures, models, sweeps, validation
-    from ..stability import circle, onset, paper
+    from ..stability import full_linear, onset, paper
 
     if args.figure is not None:
         validation.check_output_file("--figure", args.figure)
@@ -81,23 +81,24 @@ def _cmd_stability_full(args):
     out = {
         "operator": "full", "n": args.n, "theta0_deg": args.theta0, "w": args.w,
         "model": model.name, "slenderness": model.slenderness,
-        "q_crit_in_plane": nan_none(circle.critical_q(args.n, "in-plane", args.theta0, **full)),
-        "q_crit_out_of_plane": nan_none(circle.critical_q(args.n, "out-of-plane", args.theta0,
+        "q_crit_in_plane": nan_none(full_linear.critical_q(args.n, "in-plane", args.theta0,
+                                                           **full)),
+        "q_crit_out_of_plane": nan_none(full_linear.critical_q(args.n, "out-of-plane", args.theta0,
                                                           **full)),
         "q_crit_paper": nan_none(paper.critical_q(args.n)),
         "q_crit_corrected_operator": nan_none(paper.critical_q(args.n, corrected=True)),
     }
     if args.q_scan:
-        out["q_scan"] = circle.paper_comparison(
+        out["q_scan"] = full_linear.paper_comparison(
             sweeps.parse_values(args.q_scan, "--q-scan"), args.n, args.theta0, **full)
     if args.g0 is not None:
         if args.g0 < 0.0:
             raise ValueError(f"--g0 must be >= 0, got {args.g0}")
-        spec = circle.full_spectrum(args.g0, args.theta0, args.n, **full)
+        spec = full_linear.full_spectrum(args.g0, args.theta0, args.n, **full)
         top = (spec.sector != "neutral").nonzero()[0][:max(1, args.top)]
         out["spectrum"] = {
             "g0": args.g0, "q": spec.q, "neutral_modes": int((spec.sector == "neutral").sum()),
-            "growth_rate": {s: spec.growth_rate(s) for s in circle.SECTORS},
+            "growth_rate": {s: spec.growth_rate(s) for s in full_linear.SECTORS},
             "eigenvalues_real": spec.eigenvalues.real[top].tolist(),
             "eigenvalues_imag": spec.eigenvalues.imag[top].tolist(),
             "sector": spec.sector[top].tolist(),
@@ -107,7 +108,7 @@ def _cmd_stability_full(args):
         eps, t_end, detect = args.onset
         out["onset"] = {"eps": eps, "t_end": t_end, "detect": detect, **{
             f"q_{s.replace('-', '_')}": nan_none(onset.onset_q(
-                eps, t_end, detect, args.n, s, args.theta0, **full)) for s in circle.SECTORS}}
+                eps, t_end, detect, args.n, s, args.theta0, **full)) for s in full_linear.SECTORS}}
     if args.figure:
         use_agg()
         figures.save(figures.growth_rates(args.n, theta0_deg=args.theta0, **full), args.figure,

@@ -3,7 +3,7 @@ when re-run; also reruns of a sweep's failed cases (``--rerun-failed``)."""
 import math
 import sys
 
-from ..config import DEFAULT_AUTO_CHUNK_SIZE, DEFAULT_CHUNK_SIZE, DEFAULT_N, SEED_TARGETS
+from ..defaults import DEFAULT_AUTO_CHUNK_SIZE, DEFAULT_CHUNK_SIZE, DEFAULT_N, SEED_TARGETS
 from .common import (
     EXIT_FAILED_RUN, HelpFormatter, Parser, add_integration_options, check_auto_options,
     interrupted, real, save_distribution_figure, use_agg,
@@ -122,7 +122,8 @@ SEED_TARGET_HELP = {
     "max_seeds": ("K", "seeds at most per point"),
     "check_seeds": ("K", "seeds of each point whose runs are samples (its seeds end in "
                     "different regimes, or a twin ends elsewhere) rerun at the twins' stricter "
-                    "tolerances to check its distribution (summary.compare); that point's "
+                    "tolerances to check its distribution (outcome_statistics.compare); that "
+                    "point's "
                     "later seeds run without twins; 0: no check, twins throughout"),
 }
 RERUN_OPTIONS = ("method", "rtol", "atol")  # what --rerun-failed takes from the command line
@@ -188,8 +189,8 @@ def _sweep_config(args, sweeps):
 
 def _parse_seeds(args):
     """``--seeds K|auto`` into an int or "auto", and the --seeds auto targets
-    (``seeding.SeedTargets``, or None), each refused where it does not apply."""
-    from .. import seeding
+    (``seeds_auto_rule.SeedTargets``, or None), each refused where it does not apply."""
+    from .. import seeds_auto_rule
 
     if args.seeds != "auto":
         try:
@@ -212,7 +213,7 @@ def _parse_seeds(args):
         if value is not None:
             raise ValueError(f"{flag} does not apply with --seeds auto (its rounds are planned "
                              "from the grid's points as the seeds come in)")
-    return seeding.SeedTargets(**given).check()
+    return seeds_auto_rule.SeedTargets(**given).check()
 
 
 def _check_rerun_options(args):
@@ -282,9 +283,9 @@ def command(args):
                 if hasattr(stopped, "done") else "")
         return interrupted(getattr(stopped, "signum", 2),
                             f"{done}re-run the same command to resume")
-    from .. import summary
+    from .. import outcome_statistics
 
-    counts = summary.outcome_counts(frame)
+    counts = outcome_statistics.outcome_counts(frame)
     print(f"{counts['cases']} cases in {out}: "
           + ", ".join(f"{k} {v}" for k, v in counts["regimes"].items()))
     if counts["unresolved"]:
@@ -303,7 +304,7 @@ def command(args):
                   f"{k} {v}" for k, v in counts["undetermined_regimes"].items()) + ")")
     seeds_auto = args.rerun_failed is None and args.seeds == "auto"
     if seeds_auto:
-        stopped = summary.stop_counts(stops)
+        stopped = outcome_statistics.stop_counts(stops)
         print(f"{stopped['points']} points, seeds until sharp: " + ", ".join(
             f"{k} {v}" for k, v in stopped["reasons"].items())
             + f" (seeds per point {stopped['seeds_min']}-{stopped['seeds_max']}; why each "
@@ -321,13 +322,14 @@ def command(args):
     if args.figure:
         use_agg()
         if seeds_auto:
-            save_distribution_figure(summary.summarize(frame), frame, args.figure)
+            save_distribution_figure(outcome_statistics.summarize(frame), frame, args.figure)
         else:
             figures.save(figures.phase_diagram(frame), args.figure)
         print(f"{'distribution summary' if seeds_auto else 'phase diagram'}: {args.figure}")
     if counts["failed"]:
         print(f"{counts['failed']} of {counts['cases']} cases failed (column 'status'); exit "
               f"status {EXIT_FAILED_RUN}; rerun them with: "
-              f"{summary.RERUN_COMMAND.format(out=out)} (or another --rtol)", file=sys.stderr)
+              f"{outcome_statistics.RERUN_COMMAND.format(out=out)} (or another --rtol)",
+              file=sys.stderr)
         return EXIT_FAILED_RUN
     return 0

@@ -40,7 +40,7 @@ Regime colours are :data:`REGIME_STYLE` (the paper's: stable dark purple,
 in-plane green-blue, 3D yellow); cases not resolved at their n are hollow.
 """
 from .. import diagnostics, spectral, validation  # noqa: F401  (names of the former module)
-from ..stability import circle, paper  # noqa: F401  (names of the former module)
+from ..stability import full_linear, paper  # noqa: F401  (names of the former module)
 from .animation import animate, animation_figure, frame_indices, load_trajectory, write_animation
 from .distributions import (
     aspect_distribution, check_one_cell_per_point, distribution_summary, probability_phase_diagram,

@@ -3,7 +3,7 @@ aspect ratio with their medians and intervals (tables of ``loopsim.summarize``).
 import matplotlib.pyplot as plt
 import numpy as np
 
-from ..stability import circle
+from ..stability import full_linear
 from .linear import branch_lines
 from .style import REGIME_STYLE, single_axes
 
@@ -93,7 +93,7 @@ def probability_phase_diagram(cells, frame=None, ax=None, style="pie"):
                        label="some seeds not steady at t_end")
     theta = np.linspace(1.0, 90.0, 300)
     for sector, line in (("in-plane", "--"), ("out-of-plane", ":")):
-        q_sector = circle.critical_q(16, sector)
+        q_sector = full_linear.critical_q(16, sector)
         ax.plot(theta, 3 * q_sector / np.sin(np.radians(theta)), "k", ls=line, lw=1.0,
                 label=f"{sector} threshold, q = {q_sector:.3f}")
     ax.set_xlim(0, 92)
@@ -130,7 +130,7 @@ def tilt_distribution(cells, frame=None, ax=None):
                       cells["tilt_median_high"] - cells["tilt_median"]],
                 fmt="o", ms=3.5, color="#3b0f70", elinewidth=1.6, zorder=3,
                 label="median, 95% interval")
-    q_out = circle.critical_q(16, "out-of-plane")
+    q_out = full_linear.critical_q(16, "out-of-plane")
     ax.axvline(q_out, color="k", ls=":", lw=1.0, label=f"out-of-plane threshold, q = {q_out:.3f}")
     ax.set_xlabel(r"$q_0 = g_0 \sin\theta_0 / 3$")
     ax.set_ylabel(r"terminal tilt $\theta$ (deg)")
@@ -170,7 +170,7 @@ def aspect_distribution(cells, frame=None, branch=None, ax=None):
 
 
 def distribution_summary(cells, frame, branch=None):
-    """The panels of a summary table (``summary.summarize``) and its rows: the regime
+    """The panels of a summary table (``outcome_statistics.summarize``) and its rows: the regime
     probabilities per cell (:func:`probability_phase_diagram`), the terminal tilt over the seeds
     (:func:`tilt_distribution`) and, when the table has terminal q, the aspect ratio
     over the steady branch ``branch`` (:func:`aspect_distribution`)."""

@@ -3,7 +3,7 @@ import numpy as np
 import pandas as pd
 
 from .. import models
-from ..stability import circle, paper
+from ..stability import full_linear, paper
 from .style import model_text, new_figure, single_axes
 
 
@@ -12,8 +12,8 @@ def stability_data(n=16, q_values=None, n_values=range(3, 17), theta0_deg=90.0):
     out_of_plane: largest growth rates at truncation n) and ``critical`` (n, in_plane,
     out_of_plane, paper, corrected: critical q against n; NaN where none)."""
     q_values = np.linspace(0.0, 20.0, 81) if q_values is None else np.asarray(q_values, float)
-    growth = pd.DataFrame(circle.paper_comparison(q_values, n, theta0_deg))
-    critical = pd.DataFrame(circle.critical_q_table(list(n_values), theta0_deg),
+    growth = pd.DataFrame(full_linear.paper_comparison(q_values, n, theta0_deg))
+    critical = pd.DataFrame(full_linear.critical_q_table(list(n_values), theta0_deg),
                             columns=["n", "in_plane", "out_of_plane", "paper", "corrected"])
     growth.attrs["n"] = int(n)
     return growth, critical
@@ -70,7 +70,7 @@ def growth_rates(n=16, q_values=None, theta0_deg=90.0, w=None, ax=None, model=No
     kwargs = dict({} if w is None else dict(w=w), **({} if model is None else dict(model=model)))
     fig, ax = single_axes(ax, (6.4, 4.2))
     q_values = np.linspace(0.0, 20.0, 81) if q_values is None else np.asarray(q_values, float)
-    rows = circle.paper_comparison(q_values, n, theta0_deg, **kwargs)
+    rows = full_linear.paper_comparison(q_values, n, theta0_deg, **kwargs)
     get = lambda key: [r[key] for r in rows]  # noqa: E731
     ax.plot(q_values, get("paper"), "k--", label="paper's operator (§4)")
     ax.plot(q_values, get("out_of_plane"), "C0-", lw=2, label="full J, out-of-plane")
@@ -78,7 +78,7 @@ def growth_rates(n=16, q_values=None, theta0_deg=90.0, w=None, ax=None, model=No
     ax.plot(q_values, get("in_plane"), "C3-", lw=2, label="full J, in-plane")
     ax.axhline(0.0, color="0.6", lw=0.8)
     for sector, color in (("in-plane", "C3"), ("out-of-plane", "C0")):
-        qc = circle.critical_q(n, sector, theta0_deg, **kwargs)
+        qc = full_linear.critical_q(n, sector, theta0_deg, **kwargs)
         ax.axvline(qc, color=color, lw=0.8, ls="--")
         ax.annotate(f"{qc:.4f}", (qc, -14), color=color, rotation=90, ha="right", va="bottom")
     qp = paper.critical_q(n)

@@ -21,10 +21,10 @@ def read_run(path):
     """(trajectory DataFrame, summary dict) of a ``loopsim run --out`` file."""
     import pyarrow.parquet as pq
 
-    from .. import io
+    from .. import storage
 
     try:
-        meta = io.read_metadata(path)
+        meta = storage.read_metadata(path)
         if "summary" not in meta:
             raise ValueError(f"{path!r} is not a run file (written by 'loopsim run --out'): "
                              "no run summary in its metadata")
@@ -38,12 +38,12 @@ def read_run(path):
 
 
 def read_sweep(path):
-    """A sweep directory's table (``io.read_results``); ValueError, one line, if it cannot
+    """A sweep directory's table (``storage.read_results``); ValueError, one line, if it cannot
     be read or holds no finished case."""
-    from .. import io
+    from .. import storage
 
     try:
-        frame = io.read_results(path)
+        frame = storage.read_results(path)
     except (OSError, ValueError) as exc:
         raise ValueError(f"cannot read sweep {path!r}: {str(exc).splitlines()[0]}") from None
     if not len(frame):

@@ -14,9 +14,9 @@ import functools
 import numpy as np
 
 from .. import validation
-from ..config import MAX_SLENDERNESS, MODEL_CHOICES
+from ..defaults import MAX_SLENDERNESS, MODEL_CHOICES
 from ..jit import entry
-from . import local_sbt, nonlocal_circle, nonlocal_sbt, riccati  # noqa: F401 - registers them
+from . import local_sbt, nonlocal_closed_form, nonlocal_sbt, riccati  # noqa: F401 - registers them
 from .base import (
     auxiliary, for_case, implements, jacobian, monitored_errors, rhs, steady_invariants,
 )
@@ -68,7 +68,7 @@ def difference_jacobian(problem, y, step=CENTRAL_STEP):
     return jac
 
 
-#: The loop's model as a user chooses it: ``name`` one of ``config.MODEL_CHOICES``,
+#: The loop's model as a user chooses it: ``name`` one of ``defaults.MODEL_CHOICES``,
 #: ``slenderness`` ε = a/L for "nonlocal" (None for "local").
 Model = collections.namedtuple("Model", "name slenderness")
 #: The default: the paper's local slender-body theory.
@@ -77,7 +77,7 @@ LOCAL = Model("local", None)
 
 def choose(name="local", slenderness=None):
     """The :class:`Model` of a user's choice, checked: one-line ValueErrors naming the value
-    (the nonlocal model needs a slenderness in (0, ``config.MAX_SLENDERNESS``]; the local
+    (the nonlocal model needs a slenderness in (0, ``defaults.MAX_SLENDERNESS``]; the local
     one takes none)."""
     name = validation.check_choice("model", name, MODEL_CHOICES)
     if name == "local":
@@ -96,10 +96,10 @@ def choose(name="local", slenderness=None):
 def highest_order(model):
     """The highest truncation order ``model`` can run at (None: no limit below
     ``validation.MAX_N``): for the nonlocal model, one below the first mode its operator is not positive at on the circle
-    (``nonlocal_circle.first_nonpositive_mode``: ε = 1e-2 gives n ≤ 10, 1e-3 n ≤ 108)."""
+    (``nonlocal_closed_form.first_nonpositive_mode``: ε = 1e-2 gives n ≤ 10, 1e-3 n ≤ 108)."""
     if model.name == "local":
         return None
-    first = nonlocal_circle.first_nonpositive_mode(model.slenderness, validation.MAX_N + 1)
+    first = nonlocal_closed_form.first_nonpositive_mode(model.slenderness, validation.MAX_N + 1)
     return None if first is None else first - 1
 
 

@@ -8,7 +8,7 @@ tangent t the null vector of [∂H/∂u, ∂H/∂q] (norm ⟨x, x⟩ + q²), pre
 y + h t, corrector Newton on H = 0 plus ⟨t, y - y_pred⟩ = 0; a corrector that
 lands far from the prediction or turns the tangent sharply (e.g. back onto the
 circle) is rejected and the step halved.  The branch leaves the translating
-circle at the in-plane threshold q_c (``circle.critical_q``, 8.9001
+circle at the in-plane threshold q_c (``full_linear.critical_q``, 8.9001
 converged): the first corrector uses the hyperplane ⟨φ, x - x_circle⟩ = h, φ
 the mirror-symmetric null vector of ∂H/∂u at the circle (the critical
 eigenspace is double: the mirror-symmetric and the antisymmetric flattening);
@@ -42,10 +42,10 @@ import numpy as np
 from scipy.optimize import brentq
 
 from .. import spectral, validation
-from ..config import DEFAULT_W
+from ..defaults import DEFAULT_W
 from ..models import local_sbt
 from ..shapes import inclined_circle
-from .circle import critical_q, l2_weights
+from .full_linear import critical_q, l2_weights
 # The steady equations, re-exported: ``stability.branch`` has always offered them.
 from .steady import (  # noqa: F401
     NORMAL, PLANE, SteadyShape, mirror_symmetric_index, newton, planar_state, plane_index,
@@ -162,7 +162,7 @@ class Branch:
     ``q_bifurcation``: q at zero amplitude, measured on the branch: the even part
     (q(h) + q(-h)) / 2 at h = START_AMPLITUDE and 2h off the circle along φ,
     Richardson-extrapolated (error O(h⁴)); ``q_circle``: the circle's in-plane
-    threshold (``circle.critical_q``); ``shapes``: the steady shapes in arclength order,
+    threshold (``full_linear.critical_q``); ``shapes``: the steady shapes in arclength order,
     the circle at q_c first, then the side with ⟨φ, x - x_circle⟩ > 0 (``side`` +1) or
     < 0 (-1), as asked; ``null_vector``: φ (2, K) in [X, Z].
     """

@@ -10,7 +10,7 @@ import numpy as np
 import pandas as pd
 
 from .. import integrators, models, refinement, shapes, validation
-from ..config import (
+from ..defaults import (
     DEFAULT_ATOL, DEFAULT_CHUNK_SIZE, DEFAULT_LENGTH_TOL, DEFAULT_MAX_STEPS, DEFAULT_N_MAX,
     MODEL_CHOICES,
     DEFAULT_PERTURBATION, DEFAULT_RTOL, DEFAULT_STEADY_INTERVAL, DEFAULT_STEADY_TOL,

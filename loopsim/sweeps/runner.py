@@ -1,5 +1,5 @@
 """Running cases: one piece of positions integrated (in the batch kernel, or with
-snapshots through ``api.simulate``) into rows of ``io.RESULT_SCHEMA``."""
+snapshots through ``api.simulate``) into rows of ``storage.RESULT_SCHEMA``."""
 import functools
 import time
 import warnings
@@ -8,8 +8,8 @@ import numpy as np
 import pyarrow as pa
 
 from .. import (
-    _jitcache, api, columns, diagnostics, integrators, io, models, outcomes, refinement, shapes,
-    spectral,
+    _jitcache, api, columns, diagnostics, integrators, models, outcomes, refinement, shapes,
+    spectral, storage,
 )
 from .cases import case_model, case_option
 from .chunks import chunk_case_ids
@@ -99,12 +99,12 @@ def _traced_case(config, case_id):
                       [getattr(result, name) for name in integrators.COUNTS],
                       (result.length_error_max, result.tail_max), result.wall_s,
                       result.t_final, method, result.twin)
-    table = io.trajectory_table(result).replace_schema_metadata(None)
+    table = storage.trajectory_table(result).replace_schema_metadata(None)
     for name in ("x", "multiplier"):  # orders differ between cases: variable-length lists
         table = table.set_column(table.schema.get_field_index(name), name,
                                  table.column(name).cast(pa.list_(pa.float64())))
     table = table.add_column(0, "case_id", pa.array([case_id] * table.num_rows, pa.int64()))
-    return row, io.described(table, columns.TRAJECTORY_COLUMNS)
+    return row, storage.described(table, columns.TRAJECTORY_COLUMNS)
 
 
 def _group_order(item):
@@ -177,7 +177,7 @@ def run_chunk(config, chunk, threads):
     for case_id in traced:
         rows[case_id], table = _traced_case(config, case_id)
         snapshots.append(table)
-    table = pa.Table.from_pylist([rows[i] for i in sorted(rows)], schema=io.RESULT_SCHEMA)
+    table = pa.Table.from_pylist([rows[i] for i in sorted(rows)], schema=storage.RESULT_SCHEMA)
     return table, (pa.concat_tables(snapshots) if snapshots else None)
 
 
