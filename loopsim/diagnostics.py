@@ -63,11 +63,6 @@ def truncation(c, n):
     return float(np.sqrt(energy[n:].sum() / total)) if total > 0 else 0.0
 
 
-def centre_of_mass(x):
-    """(1/2π)∫x ds: the mean coefficient (arc-length weighted, |x'| = 1)."""
-    return x[:, 0].copy()
-
-
 def covariance(x):
     """C = (1/2π)∫(x - x̄)(x - x̄)ᵀ ds = ½ Σ_k (a_k a_kᵀ + b_k b_kᵀ)."""
     modes = x[:, 1:]

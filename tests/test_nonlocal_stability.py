@@ -7,6 +7,8 @@ import math
 import numpy as np
 import pytest
 
+import oracles
+
 from loopsim import api, models, shapes
 from loopsim.cli import main
 from loopsim.models import nonlocal_closed_form as closed
@@ -33,12 +35,12 @@ def test_the_tilted_circle_translates_rigidly_at_johnson_wu_mobilities(eps, thet
 
 
 def test_difference_jacobian_matches_the_exact_local_one(rng):
-    """models.difference_jacobian (central differences) against the exact local Jacobian
+    """oracles.difference_jacobian (central differences) against the exact local Jacobian
     at a deformed, tilted loop: 1e-7 relative to its largest entry."""
     x = shapes.inclined_circle(6, 0.7) + 0.05 * rng.standard_normal((3, 13))
     exact = full_linear.rhs_jacobian(x, 40.0)
     problem = models.make_problem(models.LOCAL, 6, 40.0, 10.0)
-    approx = models.difference_jacobian(problem, x.ravel())
+    approx = oracles.difference_jacobian(problem, x.ravel())
     assert np.abs(approx - exact).max() < 1e-7 * np.abs(exact).max()
 
 
@@ -52,7 +54,7 @@ def test_exact_nonlocal_jacobian_matches_central_differences_of_the_compiled_rhs
     x = shapes.inclined_circle(6, 0.7) + 0.05 * rng.standard_normal((3, 13))
     problem = models.make_problem(model, 6, 40.0, 10.0)
     exact = full_linear.rhs_jacobian(x, 40.0, model=model)
-    central = models.difference_jacobian(problem, x.ravel())
+    central = oracles.difference_jacobian(problem, x.ravel())
     assert np.abs(exact - central).max() < 1e-7 * np.abs(central).max()
 
 

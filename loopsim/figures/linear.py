@@ -3,7 +3,7 @@ import numpy as np
 import pandas as pd
 
 from .. import models
-from ..stability import full_linear, paper
+from ..stability import branch, full_linear, paper
 from .style import model_text, new_figure, single_axes
 
 
@@ -49,18 +49,12 @@ def stability(growth, critical, axes=None):
 
 
 def load_branch(n=12, q_max=25.0):
-    """The steady branch from ``stability.branch.steady_branch`` (a DataFrame), or None
-    with the reason when that module or function is not there."""
-    try:
-        from ..stability import branch as steady
-    except ImportError as exc:
-        return None, f"no steady branch: {exc}"
-    function = getattr(steady, "steady_branch", None)
-    if function is None:
-        return None, "no steady branch: loopsim.stability.branch has no steady_branch()"
-    frame = function(n=n, q_max=q_max)
-    frame.attrs.setdefault("n", n)
-    return frame, None
+    """(``stability.branch.steady_branch(n, q_max)``, None): the pair the figures once
+    took, when the branch module was optional.  Deprecated: call ``steady_branch``."""
+    from .._moved import warn_moved
+
+    warn_moved("loopsim.figures.load_branch", "loopsim.stability.branch.steady_branch")
+    return branch.steady_branch(n=n, q_max=q_max), None
 
 
 def growth_rates(n=16, q_values=None, theta0_deg=90.0, w=None, ax=None, model=None):

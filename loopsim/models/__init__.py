@@ -22,7 +22,7 @@ from .base import (
 )
 
 __all__ = ["Model", "LOCAL", "choose", "highest_order", "check_order", "make_problem",
-           "case_constants", "case_parameters", "difference_jacobian", "rhs", "jacobian", "monitored_errors",
+           "case_constants", "case_parameters", "rhs", "jacobian", "monitored_errors",
            "steady_invariants",
            "auxiliary",
            "for_case", "implements", "evaluate", "evaluate_jacobian", "local_sbt", "nonlocal_sbt",
@@ -42,30 +42,6 @@ def evaluate_jacobian(problem, y, jac):
     f = np.empty_like(y)
     rhs(problem, y, f)
     jacobian(problem, y, f, jac, np.empty_like(y), np.empty_like(y))
-
-
-#: Relative step of :func:`difference_jacobian`: the cube root of the machine epsilon.
-CENTRAL_STEP = float(np.finfo(float).eps ** (1.0 / 3.0))
-
-
-def difference_jacobian(problem, y, step=CENTRAL_STEP):
-    """∂F/∂y by central differences: column j is [F(y + h e_j) − F(y − h e_j)] / 2h with
-    h = step max(1, |y_j|) (truncation error O(h²), rounding O(ε/h): about 1e-10 relative
-    at the default step).  For analyses of a model without an exact Jacobian."""
-    y = np.array(y, dtype=float)
-    size = y.size
-    jac = np.empty((size, size))
-    plus, minus, aux = np.empty(size), np.empty(size), np.empty(size // 3)
-    for j in range(size):
-        h = step * max(1.0, abs(y[j]))
-        saved = y[j]
-        y[j] = saved + h
-        evaluate(problem, y, plus, aux)
-        y[j] = saved - h
-        evaluate(problem, y, minus, aux)
-        y[j] = saved
-        jac[:, j] = (plus - minus) / (2.0 * h)
-    return jac
 
 
 #: The loop's model as a user chooses it: ``name`` one of ``defaults.MODEL_CHOICES``,

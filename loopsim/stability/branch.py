@@ -36,6 +36,7 @@ intermediate q).
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 
 import numpy as np
@@ -57,8 +58,8 @@ __all__ = [
     "PLANE", "NORMAL", "steady_residual", "steady_jacobian", "SteadyShape", "solve_steady",
     "planar_state", "tilt_shape", "to_plane", "mirror_symmetric_index",
     "neutral_modes", "stability", "Branch", "continue_branch", "steady_branch",
-    "q_loss_out_of_plane", "branch_rows", "branch_summary", "ROW_FIELDS", "upper_half",
-    "out_of_plane_loss", "out_of_plane_loss_near",
+    "q_loss_out_of_plane", "branch_rows", "branch_summary", "ROW_FIELDS", "upper_half", "steady_branch_to",
+    "out_of_plane_loss_near",
 ]
 
 #: First corrector's distance from the circle along φ (L² amplitude), and the
@@ -349,15 +350,6 @@ def upper_half(n, q_max, w=DEFAULT_W, step_max=None):
     raise ValueError(f"no half of the branch leaves towards q > q_c at n = {n}")
 
 
-def out_of_plane_loss(n, q_max=45.0, w=DEFAULT_W, step_max=0.5):
-    """q_loss_out_of_plane at truncation n: the upper half continued to q_max with steps up
-    to ``step_max`` (the crossing itself is refined by bisection, so coarse steps only
-    risk missing a crossing and recrossing between two points); None if none."""
-    half = upper_half(n, q_max, w, step_max)
-    rows = [_row(shape, 1) for shape in half.shapes]
-    return q_loss_out_of_plane(rows, half.shapes)
-
-
 def steady_branch(n=12, q_max=25.0, w=DEFAULT_W, q_min=None):
     """The branch of steady in-plane shapes as a pandas DataFrame (columns ``ROW_FIELDS``),
     for figures (the paper's Fig. 8: terminal aspect ratio against q, stable parts solid).
@@ -371,6 +363,13 @@ def steady_branch(n=12, q_max=25.0, w=DEFAULT_W, q_min=None):
     frame = pd.DataFrame(result["branch"], columns=list(ROW_FIELDS))
     frame.attrs.update({key: value for key, value in result.items() if key != "branch"})
     return frame
+
+
+@functools.lru_cache(maxsize=4)
+def steady_branch_to(q_max):
+    """The local model's steady branch at n = 12 up to ``q_max`` (:func:`steady_branch`),
+    computed once per process for each ``q_max``."""
+    return steady_branch(n=12, q_max=q_max)
 
 
 def branch_summary(n=12, q_max=25.0, w=DEFAULT_W, q_min=None):
