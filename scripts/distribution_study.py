@@ -33,7 +33,8 @@ import pandas as pd
 
 import loopsim
 from loopsim import columns, defaults, refinement, shapes, spectral, storage, sweeps
-from loopsim.cli.common import directory_name, print_and_write, save_distribution_figure
+from loopsim.cli.common import directory_name, print_and_write, use_agg
+from loopsim.figures import save_distribution_figure
 
 #: What the second step varies, and the tolerances of ``--check tolerance``.
 CHECKS = ("tolerance", "resolution")
@@ -174,6 +175,7 @@ def main():
               f"{int((paired['regime'] == paired['regime_check']).sum())}")
     check_s = time.perf_counter() - started
 
+    use_agg()
     save_distribution_figure(cells, rows, os.path.join(args.runs, "summary.png"))
     print(f"\nseeds auto: {len(rows)} runs, {auto_s:.0f} s, "
           f"{rows['wall_s'].sum():.0f} s summed case time; "

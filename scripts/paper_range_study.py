@@ -42,7 +42,8 @@ import numpy as np
 import pandas as pd
 
 from loopsim import cli, columns, outcome_statistics, storage
-from loopsim.cli.common import print_and_write, save_distribution_figure
+from loopsim.cli.common import print_and_write, use_agg
+from loopsim.figures import save_distribution_figure
 
 #: The paper's grid: g0 = 10..350 in 15 values, θ0 = 6..90° in 15.
 G0 = np.linspace(10.0, 350.0, 15)
@@ -157,6 +158,7 @@ def main():
         print(f"  ({cell['g0']:.1f}, {cell['theta0_deg']:g}°): "
               f"{int(cell['seeds'] - cell['steady'])} of {int(cell['seeds'])}")
     if args.figure:
+        use_agg()
         save_distribution_figure(table, frame.drop(columns="part"), args.figure, dpi=FIGURE_DPI)
         print(f"figure: {args.figure}")
 

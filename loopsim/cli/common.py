@@ -1,7 +1,6 @@
 """What the commands share: exit statuses, the parser's classes and argument types,
 the integration options, and the ways a command prints, draws and ends."""
 import argparse
-import functools
 import math
 import os
 import sys
@@ -191,33 +190,3 @@ def use_agg():
     import matplotlib
 
     matplotlib.use("Agg")
-
-
-#: Where the steady branch drawn under a distribution summary ends, at most (its cost
-#: grows with it: about 25 s to q = 25 at n = 12 on one core).
-BRANCH_Q_MAX = 25.0
-
-
-@functools.lru_cache(maxsize=4)
-def steady_branch_to(q_max):
-    """The local model's steady branch at n = 12 up to ``q_max`` (a DataFrame, or None),
-    computed once per process for each ``q_max``."""
-    from ..figures.linear import load_branch
-
-    return load_branch(12, q_max=q_max)[0]
-
-
-def save_distribution_figure(table, frame, path, dpi=150):
-    """Draw a summary table and its rows (``figures.distribution_summary``) to ``path``:
-    for the local model over its steady branch up to the largest terminal q seen,
-    rounded up to a multiple of 5 (at most :data:`BRANCH_Q_MAX`)."""
-    from .. import figures
-
-    use_agg()
-    branch = None
-    q_final = frame["q_final"].to_numpy(float) if "q_final" in frame else []
-    q_seen = [float(q) for q in q_final if q == q]
-    if figures.frame_model(frame).name == "local" and q_seen:
-        branch = steady_branch_to(min(BRANCH_Q_MAX, 5.0 * math.ceil(1.05 * max(q_seen) / 5.0)
-                                      or 5.0))
-    figures.save(figures.distribution_summary(table, frame, branch=branch), path, dpi=dpi)

@@ -1,8 +1,6 @@
 """``loopsim summary``: one row per cell of a sweep (regime probabilities, medians, with
 intervals), printed and optionally written and drawn."""
-from .common import (
-    HelpFormatter, directory_name, print_and_write, save_distribution_figure,
-)
+from .common import HelpFormatter, directory_name, print_and_write, use_agg
 
 
 def add_parser(commands):
@@ -50,6 +48,7 @@ def command(args):
                                            summary_of=directory_name(args.sweep_dir)),
                     shown, declarations=columns.SUMMARY_COLUMNS)
     if args.figure is not None:
-        save_distribution_figure(table, frame, args.figure)
+        use_agg()
+        figures.save_distribution_figure(table, frame, args.figure)
         print(f"figure: {args.figure}")
     return 0

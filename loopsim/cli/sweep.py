@@ -6,7 +6,7 @@ import sys
 from ..defaults import DEFAULT_AUTO_CHUNK_SIZE, DEFAULT_CHUNK_SIZE, DEFAULT_N, SEED_TARGETS
 from .common import (
     EXIT_FAILED_RUN, HelpFormatter, Parser, add_integration_options, check_auto_options,
-    interrupted, real, save_distribution_figure, use_agg,
+    interrupted, real, use_agg,
 )
 
 
@@ -322,7 +322,8 @@ def command(args):
     if args.figure:
         use_agg()
         if seeds_auto:
-            save_distribution_figure(outcome_statistics.summarize(frame), frame, args.figure)
+            figures.save_distribution_figure(outcome_statistics.summarize(frame), frame,
+                                             args.figure)
         else:
             figures.save(figures.phase_diagram(frame), args.figure)
         print(f"{'distribution summary' if seeds_auto else 'phase diagram'}: {args.figure}")

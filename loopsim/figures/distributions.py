@@ -1,11 +1,17 @@
 """Outcomes over seeds as distributions: regime probabilities per cell, terminal tilt and
 aspect ratio with their medians and intervals (tables of ``loopsim.summarize``)."""
+import math
+
 import matplotlib.pyplot as plt
 import numpy as np
 
-from ..stability import full_linear
+from ..stability import branch as steady, full_linear
 from .linear import branch_lines
-from .style import REGIME_STYLE, single_axes
+from .style import REGIME_STYLE, frame_model, save, single_axes
+
+#: Where the steady branch drawn under a distribution summary ends, at most (its cost
+#: grows with it: about 25 s to q = 25 at n = 12 on one core).
+BRANCH_Q_MAX = 25.0
 
 
 def wedge_marker(start, stop, points=24):
@@ -181,3 +187,16 @@ def distribution_summary(cells, frame, branch=None):
     if panels == 3:
         aspect_distribution(cells, frame, branch=branch, ax=axes[2])
     return fig
+
+
+def save_distribution_figure(table, frame, path, dpi=150):
+    """Draw a summary table and its rows (:func:`distribution_summary`) to ``path``: for
+    the local model over its steady branch up to the largest terminal q seen, rounded up
+    to a multiple of 5 (at most :data:`BRANCH_Q_MAX`)."""
+    branch = None
+    q_final = frame["q_final"].to_numpy(float) if "q_final" in frame else []
+    q_seen = [float(q) for q in q_final if q == q]
+    if frame_model(frame).name == "local" and q_seen:
+        branch = steady.steady_branch_to(
+            min(BRANCH_Q_MAX, 5.0 * math.ceil(1.05 * max(q_seen) / 5.0) or 5.0))
+    save(distribution_summary(table, frame, branch=branch), path, dpi=dpi)
