@@ -17,10 +17,14 @@ Main entry points:
 * :class:`LoopsimWarning`: a result that is not resolved or not determined;
 * the ``loopsim`` command (``loopsim --help``, docs/cli.md).
 
-Internals, each layer importing only those above it: ``config``, ``validation``,
-``spectral``, ``dispatch``; ``models``; ``integrators``; ``batch``; ``diagnostics``,
-``shapes``, ``stability``; ``io``; ``result``, ``api``, ``sweeps``, ``summary``, ``figures``,
-``cli``.
+Internals, each layer importing only those before it (tests/test_layout.py checks that
+every module is named here and that no import goes to a later layer; docs/extending.md's
+module table is made from this list): ``_version``, ``_signals``, ``_moved``,
+``_jitcache``, ``_blas``, ``defaults``, ``exit_codes``, ``render_defaults``, ``columns``,
+``spectral``; ``jit``, ``validation``, ``diagnostics``; ``dispatch``, ``linalg``,
+``outcomes``, ``storage``; ``models``, ``outcome_statistics``, ``shapes``; ``integrators``,
+``seeds_auto_rule``, ``stability``; ``batch``, ``figures``, ``result``; ``refinement``,
+``sweep_report``; ``api``; ``sweeps``; ``cli``, ``ensemble``; ``__main__``.
 """
 from . import _moved, _signals
 
