@@ -172,7 +172,7 @@ STOP_COLUMNS = {
     "seeds": (COUNT, "seeds run for the cell"),
     "rounds": (COUNT, "rounds the cell took part in"),
     "stop_reason": (TEXT, "why the cell stopped: deterministic, sharp or cap (--max-seeds reached) "
-                          "(loopsim.seeds_auto_rule)"),
+                          "(loopsim.seeding)"),  # stored in data/'s tables: renamed with them
     "p_halfwidth": (PROBABILITY, "largest half-width of the regime shares' 95% Wilson "
                                  "intervals at the stop"),
     "tilt_halfwidth_deg": (DEG, "half-width of the median terminal tilt's 95% bootstrap "
