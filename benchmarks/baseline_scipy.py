@@ -93,7 +93,7 @@ def main():
     reference = loopsim.simulate(args.g0, args.theta0, rtol=1e-12, atol=1e-14,
                                  method=args.reference_method, **run).x_final
     x0 = shapes.initial_shape(n, np.radians(args.theta0), 1e-3, 0)
-    rhs = NumpyLoop(n, args.g0, loopsim.config.DEFAULT_W)
+    rhs = NumpyLoop(n, args.g0, loopsim.defaults.DEFAULT_W)
     u_check = rhs(0.0, x0.ravel()).reshape(3, -1)
     u_loopsim, _ = loopsim.evaluate_maps(x0, args.g0)
     print(f"# n = {n}, g0 = {args.g0}, theta0 = {args.theta0}, t_end = {args.t_end}; "

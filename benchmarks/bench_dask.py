@@ -19,9 +19,9 @@ import time
 
 import pandas as pd
 
-from loopsim import io, sweeps
+from loopsim import storage, sweeps
 
-DETERMINISTIC = [c for c in io.RESULT_SCHEMA.names if c != "wall_s"]
+DETERMINISTIC = [c for c in storage.RESULT_SCHEMA.names if c != "wall_s"]
 
 
 def timed(config, **options):

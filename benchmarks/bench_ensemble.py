@@ -81,8 +81,8 @@ def main():
     walls = {}
     for label, cost in (("grid order", None), ("by q0", q0)):
         start = time.perf_counter()
-        batch.integrate_cases(method_id, operators, np.column_stack([g0, np.full(len(g0), 10.0)]), x0, 3.0,
-                              options, cost=cost)
+        batch.integrate_batch(method_id, operators, np.column_stack([g0, np.full(len(g0), 10.0)]),
+                              x0, 3.0, options, cost=cost)
         walls[label] = time.perf_counter() - start
     print(f"# load balance, 2 threads, one batch, t_end = 3: lanes in grid order "
           f"{walls['grid order']:.1f} s, by decreasing q0 {walls['by q0']:.1f} s "

@@ -163,7 +163,7 @@ def main():
     parser.add_argument("--parts", action="store_true")
     parser.add_argument("--rhs-only", action="store_true")
     args = parser.parse_args()
-    g0, w = 150.0, loopsim.config.DEFAULT_W
+    g0, w = 150.0, loopsim.defaults.DEFAULT_W
     start = loopsim.simulate(g0, 45.0, n=12, t_span=(0, 0.3), method="radau5").x_final
     base = None
     if args.baseline:

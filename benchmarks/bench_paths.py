@@ -94,7 +94,7 @@ def main():
     parser.add_argument("--out")
     parser.add_argument("--baseline", metavar="REV")
     args = parser.parse_args()
-    w = loopsim.config.DEFAULT_W
+    w = loopsim.defaults.DEFAULT_W
     # the comparator: (make_problem(g0, n), package), the dense path by default
     other = (lambda g0, n: DenseLoopProblem(g0, w, local_sbt.make_operators(n),
                                             local_sbt.make_workspace(n)), loopsim)

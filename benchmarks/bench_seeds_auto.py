@@ -12,7 +12,7 @@ import os
 import time
 
 import loopsim
-from loopsim import io
+from loopsim import storage
 
 
 def cost(frame):
@@ -28,12 +28,12 @@ def run(label, out, g0, theta0, max_seeds, check_seeds, threads):
                          check_seeds=check_seeds, threads=threads)
     wall = time.perf_counter() - start
     evaluations, seconds = cost(rows)
-    check = os.path.join(out, io.CHECK_DIR)
+    check = os.path.join(out, storage.CHECK_DIR)
     if os.path.isdir(check):
         extra = cost(loopsim.read_results(check))
         evaluations, seconds = evaluations + extra[0], seconds + extra[1]
     cells = loopsim.summarize(rows)
-    stops = io.read_stop_table(out)
+    stops = storage.read_stop_table(out)
     return dict(label=label, rows=len(rows), nfev=evaluations, case_s=seconds, wall_s=wall,
                 cells=cells[["g0", "theta0_deg", "seeds", "determined", "p_3d", "p_in_plane",
                              "tilt_median"]].to_dict("records"),

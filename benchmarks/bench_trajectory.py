@@ -47,7 +47,7 @@ LABELS = {"radau5": "radau5 (loopsim)", "radau5-old": "radau5 (loopsim at {rev})
 
 def problem_of(package, g0, n):
     sbt = sys.modules[package.__name__ + ".models.local_sbt"]
-    return sbt.LoopProblem(g0, loopsim.config.DEFAULT_W, sbt.make_operators(n),
+    return sbt.LoopProblem(g0, loopsim.defaults.DEFAULT_W, sbt.make_operators(n),
                            sbt.make_workspace(n))
 
 

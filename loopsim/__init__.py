@@ -17,14 +17,19 @@ Main entry points:
 * :class:`LoopsimWarning`: a result that is not resolved or not determined;
 * the ``loopsim`` command (``loopsim --help``, docs/cli.md).
 
-Internals, each layer importing only those above it: ``config``, ``validation``,
-``spectral``, ``dispatch``; ``models``; ``integrators``; ``batch``; ``diagnostics``,
-``shapes``, ``stability``; ``io``; ``result``, ``api``, ``sweeps``, ``summary``, ``figures``,
-``cli``.
+Internals, each layer importing only those before it (tests/test_layout.py checks that
+every module is named here and that no import goes to a later layer; docs/extending.md's
+module table is made from this list): ``_version``, ``_signals``, ``_moved``,
+``_jitcache``, ``_blas``, ``defaults``, ``exit_codes``, ``render_defaults``, ``columns``,
+``spectral``; ``jit``, ``validation``, ``diagnostics``; ``dispatch``, ``linalg``,
+``outcomes``, ``storage``; ``models``, ``outcome_statistics``, ``shapes``; ``integrators``,
+``seeds_auto_rule``, ``distribution_differences``, ``stability``; ``batch``, ``figures``, ``result``; ``refinement``,
+``sweep_report``; ``api``; ``sweeps``; ``cli``, ``ensemble``; ``__main__``.
 """
-from . import _signals
+from . import _moved, _signals
 
 _signals.install_early()  # the loopsim program: Ctrl-C while loading is one line, exit 130
+_moved.install()  # the old paths of renamed modules, for one release (CHANGELOG.md)
 
 from ._version import __version__  # noqa: E402
 
@@ -33,8 +38,9 @@ from ._version import __version__  # noqa: E402
 _EXPORTS = {
     "simulate": "api", "SimulationResult": "api", "evaluate_maps": "api",
     "SUMMARY_FIELDS": "api", "LoopsimWarning": "api", "stability_parameter": "diagnostics",
-    "coefficients": "io", "read_results": "io", "read_snapshots": "io", "sweep": "sweeps",
-    "summarize": "summary", "compare": "summary",
+    "coefficients": "storage", "read_results": "storage", "read_snapshots": "storage",
+    "sweep": "sweeps",
+    "summarize": "outcome_statistics", "compare": "outcome_statistics",
     "animate": "figures.animation", "report": "sweep_report",
 }
 __all__ = list(_EXPORTS) + ["__version__"]

@@ -9,7 +9,7 @@ kernels (a Numba decorator or ``numba.extending``), and, read with
 ``ast``, everything they import from the package, transitively (a kernel can
 only see globals of modules its own module imports).  Any change there starts
 a fresh cache; an edit to the command line or the figures does not.  :func:`configure`
-must run before any ``@njit(cache=True)`` decorator: ``config.JIT``, which every kernel
+must run before any ``@njit(cache=True)`` decorator: ``loopsim.jit``, which every kernel
 module imports first, runs it. A user-set NUMBA_CACHE_DIR is
 respected as the parent directory.
 """
@@ -106,7 +106,7 @@ def cache_dir():
 
 def configure():
     """Point Numba's cache at :func:`cache_dir` (before kernels are decorated) and start
-    the compile clock; once per process (``config.JIT`` calls it on first use)."""
+    the compile clock; once per process (importing ``loopsim.jit`` calls it)."""
     if COMPILE_CLOCK.registered:
         return
     numba.config.CACHE_DIR = cache_dir()

@@ -8,7 +8,7 @@ a traceback.  Commands replace the handler with their own while they work (a swe
 what has finished; ``sweeps.stop_on_signals``) and restore it afterwards.
 
 Ending at once (``os._exit``) skips the cleanup of an atomic write in progress
-(``io.integrity``), so the temporary files this process is writing are registered here
+(``storage.integrity``), so the temporary files this process is writing are registered here
 (:func:`track_temporary`) and removed before it exits (:func:`remove_temporaries`).
 """
 import os
@@ -28,7 +28,7 @@ def is_program(argv=None, orig_argv=None):
     return any(a == "-m" and b == "loopsim" for a, b in zip(orig_argv, orig_argv[1:]))
 
 
-#: Temporary files of atomic writes in progress in this process (``io.integrity``).
+#: Temporary files of atomic writes in progress in this process (``storage.integrity``).
 _TEMPORARIES = set()
 
 

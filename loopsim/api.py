@@ -11,9 +11,9 @@ import warnings
 
 import numpy as np
 
-from . import _jitcache, diagnostics, integrators, io, models, outcomes, refinement, shapes, \
+from . import _jitcache, diagnostics, integrators, storage, models, outcomes, refinement, shapes, \
     validation
-from .config import (
+from .defaults import (
     DEFAULT_ATOL, DEFAULT_LENGTH_TOL, DEFAULT_MAX_STEPS, DEFAULT_N_MAX, DEFAULT_RTOL,
     DEFAULT_SEED, DEFAULT_STEADY_INTERVAL, DEFAULT_T_END, DEFAULT_TAIL_TOL, DEFAULT_W,
 )
@@ -131,7 +131,7 @@ def simulate(
         required unless ``initial`` is given (then None: the tilt is measured).
     n : int or "auto", default "auto"
         Fourier truncation order (1..128), or "auto": start at ``n_start`` and restart
-        the run from t0 at the next order of ``config.AUTO_ORDERS`` (up to ``n_max``)
+        the run from t0 at the next order of ``defaults.AUTO_ORDERS`` (up to ``n_max``)
         whenever its spectral tail passes ``tail_tol`` (``loopsim.refinement``).
     t_span : (float, float), default (0.0, 10.0)
         Start and end time, in t_u.
@@ -170,7 +170,7 @@ def simulate(
         in L/2π, a point file (CSV/Parquet, columns x, y, z; fitted by arc length and
         scaled to length 2π) or results (a ``run --out`` file, a sweep directory).  With
         ``n="auto"`` a point file starts at the lowest order whose truncation of the fit
-        leaves out at most ``config.INITIAL_CONTENT_TOL`` (1e-12) of its RMS amplitude
+        leaves out at most ``defaults.INITIAL_CONTENT_TOL`` (1e-12) of its RMS amplitude
         (at least 6, at most the ladder's top), coefficients and results at their own
         order; every order of the ladder starts from that same shape.
     initial_case_id : int or None, default None
@@ -225,6 +225,32 @@ def simulate(
         "method", ("auto" if refine else "rkf45") if method is None else method,
         refinement.METHOD_CHOICES)
     tail_tol = validation.check_real("tail_tol", tail_tol, low=0.0, low_open=True)
+    n, n_max = _start_order(n, n_max, n_start, initial, initial_case_id, model, refine)
+    x0, theta0_deg, n, perturbation, initial_info = shapes.start_shape(
+        theta0_deg, n, perturbation, seed, initial, initial_case_id)
+    models.check_order(model, n, "n_start" if refine else "n")
+    ladder = refinement.orders(n, max(n, ladder_top(model, n_max))) if refine else (n,)
+    if method == "auto":
+        method = refinement.auto_method(stability_parameter(g0, theta0_deg), n, refine)
+    t0, t_end, t_eval, rtol, atol, w, options = _run_options(
+        t_span, t_eval, snapshots, rtol, atol, w, max_steps, length_tol, first_step, min_step,
+        max_step, steady_tol, steady_interval)
+    inputs = dict(g0=g0, theta0_deg=theta0_deg, n=n, t_end=t_end, rtol=rtol, atol=atol,
+                  w=w, perturbation=perturbation, seed=int(seed), model=model.name,
+                  slenderness=model.slenderness)
+    run, twin_state, wall, compile_s = _run_and_twin(
+        integrators.METHODS[method], g0, w, x0, t0, t_end, t_eval, options, ladder,
+        tail_tol, theta0_deg, model, twin)
+    result = _result(run, inputs, method, t_eval, g0, w, model, x0, initial_info, twin_state,
+                     wall, compile_s)
+    for line in result.warnings():
+        warnings.warn(line, LoopsimWarning, stacklevel=2)
+    return result
+
+
+def _start_order(n, n_max, n_start, initial, initial_case_id, model, refine):
+    """:func:`simulate`'s first order (checked) and, with ``n="auto"``, its top order
+    ``n_max`` (checked): the start shape's order, or ``n_start``, or the ladder's first."""
     if refine:
         validation.check_choice("n", n, ("auto",))
     if refine:
@@ -242,13 +268,13 @@ def simulate(
         raise ValueError("n_start applies only with n='auto'")
     if n is not None:
         n = validation.check_order("n_start" if refine else "n", n)
-    x0, theta0_deg, n, perturbation, initial_info = shapes.start_shape(
-        theta0_deg, n, perturbation, seed, initial, initial_case_id)
-    models.check_order(model, n, "n_start" if refine else "n")
-    ladder = refinement.orders(n, max(n, ladder_top(model, n_max))) if refine else (n,)
-    if method == "auto":
-        method = refinement.auto_method(stability_parameter(g0, theta0_deg), n, refine)
-    method_object = integrators.METHODS[method]
+    return n, n_max
+
+
+def _run_options(t_span, t_eval, snapshots, rtol, atol, w, max_steps, length_tol, first_step,
+                 min_step, max_step, steady_tol, steady_interval):
+    """:func:`simulate`'s time span, output times and tolerances, checked in this order:
+    (t0, t_end, t_eval, rtol, atol, w, the driver's options)."""
     t0, t_end = (validation.check_real("t_span[0]", t_span[0]),
                  validation.check_real("t_span[1]", t_span[1]))
     if not t_end > t0:
@@ -264,6 +290,15 @@ def simulate(
                                             low_open=True)
     if steady_tol is not None:
         steady_tol = validation.check_real("steady_tol", steady_tol, 0.0, low_open=True)
+    t_eval = _output_times(t_eval, snapshots, t0, t_end)
+    options = integrators.step_options(
+        rtol, atol, first_step, min_step, max_step, max_steps, length_tol,
+        steady_interval if steady_tol is not None else 0.0, steady_tol or 0.0)
+    return t0, t_end, t_eval, rtol, atol, w, options
+
+
+def _output_times(t_eval, snapshots, t0, t_end):
+    """:func:`simulate`'s output times, checked (an array)."""
     if t_eval is None:
         snapshots = validation.check_integer("snapshots", snapshots, 1)
         t_eval = np.linspace(t0, t_end, snapshots) if snapshots > 1 else np.array([t_end])
@@ -271,47 +306,50 @@ def simulate(
     if t_eval.ndim != 1 or not np.all(np.isfinite(t_eval)) or np.any(np.diff(t_eval) <= 0) \
             or (t_eval.size and (t_eval[0] < t0 or t_eval[-1] > t_end)):
         raise ValueError("t_eval must be finite, strictly increasing and within t_span")
+    return t_eval
 
-    inputs = dict(g0=g0, theta0_deg=theta0_deg, n=n, t_end=t_end, rtol=rtol, atol=atol,
-                  w=w, perturbation=perturbation, seed=int(seed), model=model.name,
-                  slenderness=model.slenderness)
-    options = integrators.step_options(
-        rtol, atol, first_step, min_step, max_step, max_steps, length_tol,
-        steady_interval if steady_tol is not None else 0.0, steady_tol or 0.0)
+
+def _run_and_twin(method_object, g0, w, x0, t0, t_end, t_eval, options, ladder, tail_tol,
+                  theta0_deg, model, twin):
+    """The run (``refinement.CaseRun``) and, with ``twin``, its twin's end state; the
+    run's own wall time (compilation out, the twin's share out) and the compile time."""
     compiled = _jitcache.compile_seconds()
     start = time.perf_counter()
     run = refinement.integrate_case(
         method_object, g0, w, x0, t0, t_end, t_eval, options, ladder, tail_tol, model)
-    status, t_final, x_final, n_used, counts, worst, x_out = run
     twin_state = None
-    if twin and status in integrators.SUCCESS:
+    if twin and run.status in integrators.SUCCESS:
         twin_state = twin_end_state(method_object, g0, w, x0, t0, t_end, options, ladder,
                                     tail_tol, theta0_deg, model=model)
     elif twin:  # a failed run has no outcome to check: no twin is run, and it is not determined
         twin_state = dict(regime="failed", theta_final_deg=math.nan, aspect_ratio=math.nan,
-                          nfev=0, n_used=int(n_used))
+                          nfev=0, n_used=int(run.n_used))
     compile_s = _jitcache.compile_seconds() - compiled
     wall = time.perf_counter() - start - compile_s
     if twin_state is not None:  # the twin's time is not the run's: split by RHS evaluations
-        nfev = int(counts[integrators.COUNTS.index("nfev")])
+        nfev = int(run.counts[integrators.COUNTS.index("nfev")])
         wall *= float(nfev) / (nfev + twin_state["nfev"])
+    return run, twin_state, wall, compile_s
 
-    problem = models.make_problem(model, n_used, g0, w)
-    reached = t_eval <= t_final
-    x = x_out[reached]
+
+def _result(run, inputs, method, t_eval, g0, w, model, x0, initial_info, twin_state, wall,
+            compile_s):
+    """The :class:`SimulationResult` of a run: its states at the output times reached,
+    with their velocities and multipliers."""
+    problem = models.make_problem(model, run.n_used, g0, w)
+    reached = t_eval <= run.t_final
+    x = run.x_out[reached]
     u = np.empty_like(x)
-    multiplier = np.empty((x.shape[0], x_final.shape[1]))
+    multiplier = np.empty((x.shape[0], run.x_final.shape[1]))
     for i in range(x.shape[0]):
         u[i], multiplier[i] = velocity_and_multiplier(problem, x[i])
-    u_final, multiplier_final = velocity_and_multiplier(problem, x_final)
-    stats = dict(zip(integrators.COUNTS, (int(c) for c in counts)))
-    result = SimulationResult(
+    u_final, multiplier_final = velocity_and_multiplier(problem, run.x_final)
+    stats = dict(zip(integrators.COUNTS, (int(c) for c in run.counts)))
+    return SimulationResult(
         inputs=inputs, method=method, t=t_eval[reached], x=x, u=u, multiplier=multiplier,
-        t_missed=t_eval[~reached], t_final=float(t_final), x_final=x_final, u_final=u_final,
-        multiplier_final=multiplier_final, status_code=int(status), wall_s=wall,
-        length_error_max=float(worst[0]), n_used=int(n_used), tail_max=float(worst[1]),
-        initial_info=initial_info, aspect_ratio_initial=diagnostics.aspect_ratio(x0),
-        twin=twin_state, compile_s=compile_s, **stats)
-    for line in result.warnings():
-        warnings.warn(line, LoopsimWarning, stacklevel=2)
-    return result
+        t_missed=t_eval[~reached], t_final=float(run.t_final), x_final=run.x_final,
+        u_final=u_final, multiplier_final=multiplier_final, status_code=int(run.status),
+        wall_s=wall, length_error_max=float(run.worst[0]), n_used=int(run.n_used),
+        tail_max=float(run.worst[1]), initial_info=initial_info,
+        aspect_ratio_initial=diagnostics.aspect_ratio(x0), twin=twin_state,
+        compile_s=compile_s, **stats)

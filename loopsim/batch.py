@@ -6,16 +6,17 @@ number of threads or on the order in which threads take the cases.
 Load balance: 3D cases cost several times more than stable ones, and
 Numba's ``parallel_chunksize`` did not change the schedule of this kernel
 under the OpenMP layer (measured: no effect on a loop of uneven items), so
-:func:`integrate_cases` balances by hand.  Cases are dealt round-robin, in
+:func:`integrate_batch` balances by hand.  Cases are dealt round-robin, in
 order of decreasing estimated cost, onto one lane per thread; the prange
 runs over the lanes.
 """
+import typing
+
 import numba
 import numpy as np
 
-from .config import JIT
 from .integrators import COUNTS, integrate
-from .jit import entry
+from .jit import JIT, entry
 from .models import for_case
 
 _PARALLEL_JIT = dict(JIT, parallel=True)
@@ -45,7 +46,17 @@ def parallel_cases(method, constants, parameters, x0, t0, t_end, options, order,
             worst[b] = result[4][:2]
 
 
-def integrate_cases(method, constants, parameters, x0, t_end, options, cost=None, lanes=None,
+class BatchRun(typing.NamedTuple):
+    """What :func:`integrate_batch` returns, per case b (a tuple: it unpacks in this order)."""
+
+    y_final: np.ndarray  #: (B, ny) terminal states
+    t_final: np.ndarray  #: (B,) time reached
+    status: np.ndarray  #: (B,) ``integrators.STATUS_NAMES`` codes
+    counts: np.ndarray  #: (B, 5) in the order of ``integrators.COUNTS``
+    worst: np.ndarray  #: (B, 2) largest relative length error and spectral tail met
+
+
+def integrate_batch(method, constants, parameters, x0, t_end, options, cost=None, lanes=None,
                     t0=0.0):
     """Integrate B cases of one model and truncation in parallel.
 
@@ -56,8 +67,8 @@ def integrate_cases(method, constants, parameters, x0, t_end, options, cost=None
     the initial states at times t0; t0 and t_end scalars or length-B arrays;
     ``options`` the driver options (``integrators.step_options``).
 
-    Returns (y_final, t_final, status, counts, worst): counts (B, 5) in the order
-    of ``integrators.COUNTS``; worst (B, 2) the largest relative length error and
+    Returns a :class:`BatchRun` (y_final, t_final, status, counts, worst): counts (B, 5)
+    in the order of ``integrators.COUNTS``; worst (B, 2) the largest relative length error and
     spectral tail met along each trajectory (``integrators.integrate``).  ``cost``: an estimate
     of each case's cost (any monotone proxy; default: all equal) used to deal
     cases onto ``lanes`` (default: the Numba thread count).
@@ -85,4 +96,15 @@ def integrate_cases(method, constants, parameters, x0, t_end, options, cost=None
     else:
         parallel_cases(method, constants, parameters, x0, t0, t_end, options, order, lanes,
                        *outputs)
-    return y_final, t_final, status, counts, worst
+    return BatchRun(y_final, t_final, status, counts, worst)
+
+
+def __getattr__(name):
+    """``integrate_cases``, this function's name until it met ``refinement.integrate_cases``:
+    deprecated, kept for one release."""
+    if name == "integrate_cases":
+        from ._moved import warn_moved
+
+        warn_moved("loopsim.batch.integrate_cases", "loopsim.batch.integrate_batch")
+        return integrate_batch
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -1,6 +1,6 @@
 """Every column loopsim writes, declared once: its unit and what it means.
 
-The units are those of the dimensionless equations (``loopsim.config``; docs/model.md,
+The units are those of the dimensionless equations (``loopsim.defaults``; docs/model.md,
 "Units"): lengths in L/2π (the loop has length 2π), time in
 t_u = ζ⊥ (L/2π)⁴ / EI (ζ⊥ = 8πμ/c the perpendicular drag coefficient per unit length),
 forces (the axial force N, the multiplier T) in EI (2π/L)², force densities in

@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from . import spectral
-from .config import DEFORMATION_FLOOR
+from .defaults import DEFORMATION_FLOOR
 
 #: Fine grid points per unit of order for tension profiles and lengths.
 PROFILE_POINTS_PER_ORDER = 64
@@ -42,7 +42,7 @@ def mode_energy(c):
 def spectral_tail(c, n):
     """Share of the deformation (modes k ≥ 2) carried by the top modes k ≥ max(2, n - 1):
     sqrt(Σ_{k ≥ max(2, n-1)} E_k / (Σ_{k ≥ 2} E_k + φ² Σ_{k ≥ 1} E_k)), φ the
-    ``config.DEFORMATION_FLOOR`` (below it a loop counts as a circle)."""
+    ``defaults.DEFORMATION_FLOOR`` (below it a loop counts as a circle)."""
     energy = mode_energy(c)
     scale = energy[1:].sum() + DEFORMATION_FLOOR**2 * energy.sum()
     return float(np.sqrt(energy[max(2, n - 1) - 1 :].sum() / scale)) if scale > 0 else 0.0
@@ -61,11 +61,6 @@ def truncation(c, n):
     energy = mode_energy(c)
     total = energy.sum()
     return float(np.sqrt(energy[n:].sum() / total)) if total > 0 else 0.0
-
-
-def centre_of_mass(x):
-    """(1/2π)∫x ds: the mean coefficient (arc-length weighted, |x'| = 1)."""
-    return x[:, 0].copy()
 
 
 def covariance(x):

@@ -9,7 +9,7 @@ generic from plain Python raises; call it from an njit function.
 from numba import types
 from numba.extending import overload
 
-from .config import JIT
+from .jit import JIT
 
 _IMPLEMENTATIONS = {}
 

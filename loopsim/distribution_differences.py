@@ -32,7 +32,7 @@ Plain NumPy: nothing here integrates.
 import numpy as np
 from scipy.stats import binom, norm
 
-from .summary import Z95, wilson_interval
+from .outcome_statistics import Z95, wilson_interval
 
 #: Probability of detecting a difference of the stated size (the power of ``*_detectable``).
 POWER = 0.8

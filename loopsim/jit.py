@@ -16,9 +16,19 @@ import functools
 
 import numba
 
-from .config import JIT
+from . import _jitcache
 
-#: Options of every entry (``config.JIT``: cached, no fastmath).
+# Numba's cache points at loopsim's (``_jitcache.configure``) before the first decorator:
+# every kernel module imports this one first, so the cache is set up exactly when the
+# first kernel is defined, and the command line, which defines none, loads neither Numba
+# nor NumPy (``--help`` is fast).
+_jitcache.configure()
+
+#: The options of every compiled function.  No fastmath: results must be bit-reproducible
+#: across thread counts.
+JIT = dict(cache=True, nogil=True, error_model="numpy")
+
+#: Options of every entry (:data:`JIT`: cached, no fastmath).
 ENTRY_JIT = JIT
 #: Options of every kernel: an entry's without the Python and C entry wrappers.
 KERNEL_JIT = dict(JIT, no_cpython_wrapper=True, no_cfunc_wrapper=True)

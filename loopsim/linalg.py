@@ -30,8 +30,7 @@ from numba.core import cgutils
 from numba.extending import intrinsic, overload
 from numba.np.linalg import F_INT_nbtype, F_INT_nptype, ensure_lapack
 
-from .config import JIT
-from .jit import kernel
+from .jit import JIT, kernel
 
 ensure_lapack()
 #: Integer type of the pivot array (LAPACK's Fortran integer).

@@ -25,7 +25,7 @@ import math
 import numpy as np
 
 from . import diagnostics
-from .config import RESOLVED_LENGTH_ERROR, RESOLVED_TAIL
+from .defaults import RESOLVED_LENGTH_ERROR, RESOLVED_TAIL
 
 #: The regimes (paper §6) and the label of a failed run.
 REGIMES = ("stable", "in-plane", "3d", "failed")
@@ -42,7 +42,7 @@ class Thresholds:
     (in-plane; paper §6: stable = shape and tilt unchanged).
     resolved_length_error, resolved_tail: a case is resolved at its n when its worst
     transient relative length error and its largest spectral tail along the run stay at
-    or below these (``config.RESOLVED_LENGTH_ERROR``, ``config.RESOLVED_TAIL``).
+    or below these (``defaults.RESOLVED_LENGTH_ERROR``, ``defaults.RESOLVED_TAIL``).
     determined_tilt_deg, determined_aspect: the largest run–twin differences of a
     determined case (module docstring): a fifth of the accuracy users ask of a
     terminal state (0.05 deg, 1e-3), so that the run's error, about the difference,

@@ -18,7 +18,7 @@ partial runs, which end where their tail passes ``tail_tol``, early in a 3D
 transient (counted in the case's ``nfev`` and ``wall_s``; docs/auto-and-determinacy.md).
 
 Everything here is orchestration of the compiled driver, level by level: a level
-is one call of ``integrators.integrate`` (one case) or ``batch.integrate_cases``
+is one call of ``integrators.integrate`` (one case) or ``batch.integrate_batch``
 (many cases in parallel).
 """
 import typing
@@ -27,7 +27,7 @@ import numpy as np
 
 from . import batch, integrators, models, spectral, validation
 from ._blas import one_blas_thread
-from .config import AUTO_ORDERS, DEFAULT_N
+from .defaults import AUTO_ORDERS, DEFAULT_N
 from .integrators.control import REFINE
 
 #: Where ``n="auto"`` starts for the tilted circle (the paper's resolution).
@@ -49,7 +49,7 @@ def auto_method(q0, n, refine):
 
 
 def orders(n_start, n_max):
-    """The ladder: ``config.AUTO_ORDERS`` strictly between n_start and n_max, with both
+    """The ladder: ``defaults.AUTO_ORDERS`` strictly between n_start and n_max, with both
     ends included (n_start ≤ n_max)."""
     n_start = validation.check_integer("n", n_start, 1)
     n_max = validation.check_integer("n_max", n_max, n_start)
@@ -145,16 +145,16 @@ def integrate_cases(method, parameters, x0, t_end, options, ladder, tail_tol, co
         if not active.size:
             break
         with one_blas_thread():  # the cases run in parallel already
-            y_final, t_final, level_status, level_counts, level_worst = batch.integrate_cases(
+            level_run = batch.integrate_batch(
                 method, models.case_constants(model, n), parameters[active],
                 np.array([spectral.resize(x0[b], n).ravel() for b in active]), t_end[active],
                 level_options(options, tail_tol, level == len(ladder) - 1),
                 cost=cost[active])
         for row, b in enumerate(active):
-            x[b] = y_final[row].reshape(3, -1)
-            t[b] = t_final[row]
-            status[b] = level_status[row]
-            counts[b] += level_counts[row]
-            worst[b] = level_worst[row][:2]
+            x[b] = level_run.y_final[row].reshape(3, -1)
+            t[b] = level_run.t_final[row]
+            status[b] = level_run.status[row]
+            counts[b] += level_run.counts[row]
+            worst[b] = level_run.worst[row][:2]
             n_used[b] = n
     return CasesRun(x, n_used, t, status, counts, worst)

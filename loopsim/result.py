@@ -5,13 +5,13 @@ import dataclasses
 
 import numpy as np
 
-from . import diagnostics, integrators, io, outcomes
+from . import diagnostics, integrators, outcomes, storage
 from .diagnostics import stability_parameter
 
 #: The keys of ``SimulationResult.summary()`` and of ``loopsim run --json``, in order:
 #: the inputs, the run's statistics, the outcome and the final state's diagnostics (each
 #: a column of ``loopsim.columns.RESULT_COLUMNS``, with its unit).
-SUMMARY_FIELDS = io.SUMMARY_FIELDS
+SUMMARY_FIELDS = storage.SUMMARY_FIELDS
 #: solve_ivp's status: -1 the integration failed, 0 it reached t_end, 1 it stopped
 #: early at a steady terminal state (a termination event).
 FAILED, REACHED_END, STOPPED_EARLY = -1, 0, 1
@@ -235,7 +235,7 @@ def terminal_summary(inputs, x, u, multiplier, **run_stats):
 
     ``inputs``: g0, theta0_deg, n, t_end, rtol, atol, w, perturbation, seed, model,
     slenderness;
-    ``run_stats``: the ``io.RUN_FIELDS`` and ``io.OUTCOME_FIELDS``.
+    ``run_stats``: the ``storage.RUN_FIELDS`` and ``storage.OUTCOME_FIELDS``.
     """
     values = dict(inputs, **run_stats)
     values["q0"] = stability_parameter(inputs["g0"], inputs["theta0_deg"])

@@ -1,17 +1,18 @@
 """``loopsim report``: one self-contained HTML page of a sweep directory.
 
 The page holds, in this order: the command and its provenance (loopsim version,
-creation times, machine: the result files' metadata, ``io.read_results``); the
-counts by regime, resolved and determined (``summary.outcome_counts``: the numbers
+creation times, machine: the result files' metadata, ``storage.read_results``); the
+counts by regime, resolved and determined (``outcome_statistics.outcome_counts``: the numbers
 ``loopsim sweep`` closes with); the phase diagram (``figures.phase_diagram``), or for
 a ``--seeds auto`` directory the regime probabilities per cell and the distribution
 panels (``figures.distribution_summary``, without the steady branch); the failed cases
-with their status and the rerun command (``summary.RERUN_COMMAND``); the costliest cases
-and the total cost (``summary.costliest``, ``summary.cost``); and the per-cell table
-(``summary.summarize``: the table ``loopsim summary`` prints).  Images are PNG data
+with their status and the rerun command (``outcome_statistics.RERUN_COMMAND``); the
+costliest cases and the total cost (``outcome_statistics.costliest``,
+``outcome_statistics.cost``); and the per-cell table (``outcome_statistics.summarize``: the
+table ``loopsim summary`` prints).  Images are PNG data
 URIs; the page loads nothing from the network and runs no script.
 
-Orchestration only: every number comes from ``loopsim.summary`` and every image from
+Orchestration only: every number comes from ``loopsim.outcome_statistics`` and every image from
 ``loopsim.figures``.
 """
 import base64
@@ -19,15 +20,16 @@ import html
 import io as _bytes
 import os
 
-from . import outputs
+from . import render_defaults
 
 #: Columns of the per-cell table shown (those present), in order: the cell's inputs
-#: first (``summary.CELL_INPUTS``), then these.
+#: first (``outcome_statistics.CELL_INPUTS``), then these.
 CELL_COLUMNS = ("seeds", "resolved", "determined", "steady", "p_stable", "p_in_plane", "p_3d",
                 "p_failed", "p_3d_low", "p_3d_high", "tilt_median", "tilt_median_low",
                 "tilt_median_high", "aspect_median", "wall_s")
-#: Costliest cases listed by default; resolution of the embedded figures (``loopsim.outputs``).
-COSTLIEST, REPORT_DPI = outputs.REPORT_COSTLIEST, outputs.REPORT_DPI
+#: Costliest cases listed by default; resolution of the embedded figures
+#: (``loopsim.render_defaults``).
+COSTLIEST, REPORT_DPI = render_defaults.REPORT_COSTLIEST, render_defaults.REPORT_DPI
 
 _STYLE = """body{font-family:sans-serif;max-width:72em;margin:1.5em auto;padding:0 1em;
 color:#222}table{border-collapse:collapse;font-size:0.85em;margin:0.5em 0 1.2em}
@@ -127,12 +129,12 @@ def _figures(frame, cells, seeds_auto):
 
 
 def _failed(frame, sweep_dir):
-    from . import summary
+    from . import outcome_statistics
 
     failed = frame[frame["status"] != "ok"]
     if not len(failed):
         return "<h2>Failed cases</h2><p>none</p>"
-    command = summary.RERUN_COMMAND.format(out=sweep_dir)
+    command = outcome_statistics.RERUN_COMMAND.format(out=sweep_dir)
     return (f"<h2>Failed cases</h2><p class='warn'>{len(failed)} of {len(frame)} cases failed "
             f"(reason: column <code>status</code>); rerun them with:</p>"
             f"<pre id='rerun'>{html.escape(command)}</pre>"
@@ -141,14 +143,14 @@ def _failed(frame, sweep_dir):
 
 
 def _cost(frame, count):
-    from . import summary
+    from . import outcome_statistics
 
-    total = summary.cost(frame)
+    total = outcome_statistics.cost(frame)
     return (f"<h2>Cost</h2><p id='total-cost'>{total['cases']} cases, "
             f"{total['wall_s']:.4g} s of integration in all (wall_s summed), "
             f"{total['nfev']} right-hand sides, {total['twin_nfev']} more in twins.</p>"
             f"<p>The {min(count, len(frame))} costliest cases:</p>"
-            + table_html(summary.costliest(frame, count), table_id="costliest"))
+            + table_html(outcome_statistics.costliest(frame, count), table_id="costliest"))
 
 
 def report_html(sweep_dir, seed=0, costliest=COSTLIEST):
@@ -156,15 +158,15 @@ def report_html(sweep_dir, seed=0, costliest=COSTLIEST):
     string.  ``seed``: the bootstrap seed of the per-cell table (as ``loopsim summary
     --seed``); ``costliest``: how many of the costliest cases to list.  ValueError (one
     line) for a directory that cannot be read or holds no finished case."""
-    from . import figures, io, summary
+    from . import figures, outcome_statistics, storage
 
     frame = figures.read_sweep(sweep_dir)
-    seeds_auto = io.is_seeds_auto(sweep_dir)
+    seeds_auto = storage.is_seeds_auto(sweep_dir)
     stopped = None
-    if seeds_auto and os.path.isfile(os.path.join(sweep_dir, io.STOPS_FILE)):
-        stopped = summary.stop_counts(io.read_stop_table(sweep_dir))
-    cells = summary.summarize(frame, seed=seed)
-    shown = [c for c in cells.columns if c in summary.CELL_INPUTS] + list(CELL_COLUMNS)
+    if seeds_auto and os.path.isfile(os.path.join(sweep_dir, storage.STOPS_FILE)):
+        stopped = outcome_statistics.stop_counts(storage.read_stop_table(sweep_dir))
+    cells = outcome_statistics.summarize(frame, seed=seed)
+    shown = [c for c in cells.columns if c in outcome_statistics.CELL_INPUTS] + list(CELL_COLUMNS)
     meta = frame.attrs.get("loopsim", {})
     title = f"loopsim report: {os.path.basename(os.path.abspath(sweep_dir))}"
     parts = [
@@ -172,7 +174,7 @@ def report_html(sweep_dir, seed=0, costliest=COSTLIEST):
         f"<title>{html.escape(title)}</title><style>{_STYLE}</style></head><body>",
         f"<h1>{html.escape(title)}</h1>",
         _provenance(meta, sweep_dir),
-        _counts(summary.outcome_counts(frame), stopped),
+        _counts(outcome_statistics.outcome_counts(frame), stopped),
         _figures(frame, cells, seeds_auto),
         _failed(frame, sweep_dir),
         _cost(frame, costliest),
@@ -224,7 +226,7 @@ def report(sweep_dir, out, seed=0, costliest=COSTLIEST):
     >>> loopsim.report("runs/phase", "runs/phase.html")  # doctest: +SKIP
     'runs/phase.html'
     """
-    from . import io, validation
+    from . import storage, validation
 
     validation.check_output_file("out", out)
     page = report_html(os.fspath(sweep_dir), seed=seed, costliest=costliest)
@@ -233,5 +235,5 @@ def report(sweep_dir, out, seed=0, costliest=COSTLIEST):
         with open(path, "w", encoding="utf-8") as handle:
             handle.write(page)
 
-    io.write_file_atomically(os.fspath(out), write)
+    storage.write_file_atomically(os.fspath(out), write)
     return out

@@ -133,7 +133,7 @@ def check_input_file(name, path, max_bytes):
     return path
 
 
-from .config import ENVIRONMENT_ERRNOS  # noqa: E402 - re-exported
+from .exit_codes import ENVIRONMENT_ERRNOS  # noqa: E402 - re-exported
 
 
 def _probe_writable(name, path, directory):

@@ -22,13 +22,13 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 import loopsim
-from loopsim import api, io, sweeps
+from loopsim import api, storage, sweeps
 
 
 def flips(out, count, seed):
     work = out + "-flipped"
     shutil.copytree(out, work)
-    name = io.CHUNK_PATTERN.format(2, 4)
+    name = storage.CHUNK_PATTERN.format(2, 4)
     path = os.path.join(work, name)
     original = open(path, "rb").read()
     reference = loopsim.read_results(out)
@@ -69,22 +69,22 @@ def best_ms(function, repeats=30):
 
 
 def costs(out, tmp):
-    chunk = pq.read_table(os.path.join(out, io.CHUNK_PATTERN.format(0, 2)))
+    chunk = pq.read_table(os.path.join(out, storage.CHUNK_PATTERN.format(0, 2)))
     result = api.simulate(60.0, 30.0, n=16, t_span=(0.0, 1.0), snapshots=1000)
     tables = {"32-row result file": pa.concat_tables([chunk] * 16),
-              "run file, 1000 snapshots, n = 16": io.trajectory_table(result)}
+              "run file, 1000 snapshots, n = 16": storage.trajectory_table(result)}
     for label, table in tables.items():
         meta = {k: v for k, v in (table.schema.metadata or {}).items()
-                if k != io.CONTENT_KEY.encode()}
+                if k != storage.CONTENT_KEY.encode()}
         table = table.replace_schema_metadata(meta)
         paths = {k: os.path.join(tmp, f"{k}.parquet") for k in ("plain", "crc", "full")}
         write = [best_ms(lambda: pq.write_table(table, paths["plain"])),
                  best_ms(lambda: pq.write_table(table, paths["crc"], write_page_checksum=True)),
-                 best_ms(lambda: io.write_table_atomically(table, paths["full"])),
-                 best_ms(lambda: io.content_hash(table, {}))]
+                 best_ms(lambda: storage.write_table_atomically(table, paths["full"])),
+                 best_ms(lambda: storage.content_hash(table, {}))]
         read = [best_ms(lambda: pq.read_table(paths["plain"])),
                 best_ms(lambda: pq.read_table(paths["crc"], page_checksum_verification=True)),
-                best_ms(lambda: io.read_table_checked(paths["full"]))]
+                best_ms(lambda: storage.read_table_checked(paths["full"]))]
         sizes = [os.path.getsize(p) for p in paths.values()]
         print(f"{label}: {sizes[0]} bytes plain, {sizes[1]} with page CRCs, {sizes[2]} with "
               "CRCs and hash")

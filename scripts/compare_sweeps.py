@@ -7,7 +7,7 @@ REFERENCE and OTHER are sweep directories (``loopsim sweep --out``) over the sam
 (g0, θ0, seed) cases, for example the resolved grid (``--n auto``) and the paper's
 n = 6 main job.  Rows are matched on (g0, theta0_deg, seed); with ``--common`` only the
 cases both hold are compared (a sweep still running: its finished cases are a sample
-spread over the grid, see ``io.case_order``).  Prints, as Markdown:
+spread over the grid, see ``storage.case_order``).  Prints, as Markdown:
 
 * each sweep's regime counts, resolved rows and the distribution of ``n_used``;
 * the regime cross-table (rows: REFERENCE, columns: OTHER) and how many cases change

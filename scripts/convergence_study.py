@@ -41,7 +41,7 @@ import pyarrow.parquet as pq
 
 import loopsim
 from loopsim import distribution_differences as dd
-from loopsim import summary
+from loopsim import outcome_statistics
 
 G0 = np.linspace(10.0, 350.0, 15)  # the paper's grid
 G12 = ",".join(repr(float(v)) for v in G0[10:])  # 252.9 ... 350
@@ -93,14 +93,14 @@ def describe(rows):
         values = rows[name].dropna().astype(bool)
         hits = int(values.sum())
         out[f"p_{name[3:] if name.startswith('is_') else name}"] = hits / max(len(values), 1)
-        low, high = summary.wilson_interval(hits, len(values))
+        low, high = outcome_statistics.wilson_interval(hits, len(values))
         key = name[3:] if name.startswith("is_") else name
         out[f"p_{key}_low"], out[f"p_{key}_high"] = low, high
     certain = [r for r in REGIMES if dd.certain(int(rows["regime"].eq(r).sum()), len(rows))]
     out["certain_regime"] = certain[0] if certain else None
     tilt = rows["theta_final_deg"].to_numpy(float)
     out["tilt_q25"], out["tilt_q50"], out["tilt_q75"] = np.nanpercentile(tilt, [25, 50, 75])
-    out["tilt_q50_low"], out["tilt_q50_high"] = summary.bootstrap_interval(tilt)
+    out["tilt_q50_low"], out["tilt_q50_high"] = outcome_statistics.bootstrap_interval(tilt)
     out["nfev_mean"] = float(rows["nfev"].mean())
     out["wall_s"] = float(rows["wall_s"].sum())
     return out

@@ -25,7 +25,7 @@ import pyarrow.compute as pc
 import pyarrow.parquet as pq
 
 import loopsim
-from loopsim import columns, io
+from loopsim import columns, storage
 
 DATA = os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir, "data")
 #: file name: the declarations of its columns.
@@ -42,7 +42,7 @@ INTEGER_COLUMNS = ("n",)
 
 def described_table(table, declarations):
     """``table`` with its integer orders as int64, no machine path in its metadata and every
-    field's unit and description (``io.described``); its content hash left to the writer."""
+    field's unit and description (``storage.described``); its content hash left to the writer."""
     for name in INTEGER_COLUMNS:
         if name in table.column_names and not pa.types.is_integer(table.schema.field(name).type):
             values = table[name]
@@ -52,10 +52,10 @@ def described_table(table, declarations):
             table = table.set_column(table.schema.get_field_index(name), name,
                                      pc.cast(values, pa.int64()))
     meta = {k.decode(): v.decode() for k, v in (table.schema.metadata or {}).items()
-            if k.decode() != io.CONTENT_KEY}
+            if k.decode() != storage.CONTENT_KEY}
     if "summary_of" in meta:
         meta["summary_of"] = os.path.basename(os.path.normpath(meta["summary_of"]))
-    return io.described(table.replace_schema_metadata(meta), declarations)
+    return storage.described(table.replace_schema_metadata(meta), declarations)
 
 
 def with_note(table):
@@ -99,12 +99,12 @@ def main(argv=None):
     stale = []
     for name, declarations in TABLES.items():
         path = os.path.normpath(os.path.join(DATA, name))
-        before = io.read_table_checked(path, True)
+        before = storage.read_table_checked(path, True)
         table = described_table(before, declarations)
         if not same_values(before, table):
             raise SystemExit(f"describe_tables: error: {name}'s values would change")
         old_meta = {k: v for k, v in before.schema.metadata.items()
-                    if k.decode() != io.CONTENT_KEY}
+                    if k.decode() != storage.CONTENT_KEY}
         if table.schema.equals(before.schema.with_metadata(old_meta), check_metadata=True):
             print(f"{name}: unchanged")  # described already (by this script, or its writer)
             continue
@@ -113,9 +113,9 @@ def main(argv=None):
         if args.check:
             print(f"{name}: would change")
             continue
-        io.write_table_atomically(table, path)
-        if not same_values(before, io.read_table_checked(path, True)):
-            io.write_table_atomically(before, path)
+        storage.write_table_atomically(table, path)
+        if not same_values(before, storage.read_table_checked(path, True)):
+            storage.write_table_atomically(before, path)
             raise SystemExit(f"describe_tables: error: {name}'s values did not survive the "
                              "write; the file was restored")
         print(f"{name}: {len(before.column_names)} columns described, values bit-identical")

@@ -33,8 +33,9 @@ import pandas as pd
 import pyarrow as pa
 
 import loopsim
-from loopsim import columns, config, io, refinement, seeding, shapes, spectral, sweeps
-from loopsim.cli.common import directory_name, print_and_write, save_distribution_figure
+from loopsim import columns, defaults, refinement, seeds_auto_rule, shapes, spectral, storage, sweeps
+from loopsim.cli.common import directory_name, print_and_write, use_agg
+from loopsim.figures import save_distribution_figure
 
 #: What the second step varies, and the tolerances of ``--check tolerance``.
 CHECKS = ("tolerance", "resolution")
@@ -51,7 +52,7 @@ def markdown(frame, columns, formats):
 def check_cells(stops, g0, theta0):
     """The cells to check: not deterministic and not failed (no run succeeded: nothing to
     compare), and at one of ``g0`` and ``theta0`` when given (None: any)."""
-    cells = stops[~stops["stop_reason"].isin([seeding.DETERMINISTIC, seeding.FAILED])]
+    cells = stops[~stops["stop_reason"].isin([seeds_auto_rule.DETERMINISTIC, seeds_auto_rule.FAILED])]
     for column, values in (("g0", g0), ("theta0_deg", theta0)):
         if values is not None:
             cells = cells[cells[column].isin(values)]
@@ -63,10 +64,10 @@ def same_start_run(g0, theta0_deg, seed, n):
     its seeded perturbation at the ladder's first order, zero-padded exactly to ``n``),
     with the sweep's defaults and early stop, no twin: its summary row."""
     start = shapes.initial_shape(refinement.AUTO_START, math.radians(theta0_deg),
-                                 config.DEFAULT_PERTURBATION, seed)
+                                 defaults.DEFAULT_PERTURBATION, seed)
     result = loopsim.simulate(g0, None, initial=spectral.resize(start, n), n=n, method="auto",
-                              twin=False, steady_tol=config.DEFAULT_STEADY_TOL,
-                              steady_interval=config.DEFAULT_STEADY_INTERVAL)
+                              twin=False, steady_tol=defaults.DEFAULT_STEADY_TOL,
+                              steady_interval=defaults.DEFAULT_STEADY_INTERVAL)
     # the cell's inputs as given (the measured tilt differs from them by the perturbation)
     return dict(result.summary(), g0=g0, theta0_deg=theta0_deg, seed=seed, n=n)
 
@@ -80,7 +81,7 @@ def resolution_check(cells, args, directory):
     for cell in cells:
         path = os.path.join(directory, f"g{cell['g0']:g}_t{cell['theta0_deg']:g}.parquet")
         if os.path.exists(path):
-            frames.append(io.read_table_checked(path).to_pandas())  # damaged: named
+            frames.append(storage.read_table_checked(path).to_pandas())  # damaged: named
         else:
             todo.append((cell, path))
     context = multiprocessing.get_context("spawn")  # no fork of a process that ran prange
@@ -91,7 +92,7 @@ def resolution_check(cells, args, directory):
                 (cell["g0"], cell["theta0_deg"], seed, args.check_n)
                 for seed in range(args.check_seeds)])))
             frame = pd.DataFrame(rows)
-            io.write_table_atomically(pa.Table.from_pandas(frame, preserve_index=False), path)
+            storage.write_table_atomically(pa.Table.from_pandas(frame, preserve_index=False), path)
             print(f"{args.check} check: g0 = {cell['g0']:g}, theta0 = {cell['theta0_deg']:g}: "
                   f"{frame['wall_s'].sum():.0f} s summed", flush=True)
             frames.append(frame)
@@ -156,7 +157,7 @@ def main():
     rows = loopsim.sweep(g0, theta0, auto_dir, n="auto", seeds="auto",
                          max_seeds=args.max_seeds, threads=args.threads, quiet=False)
     auto_s = time.perf_counter() - started
-    stops = io.read_stop_table(auto_dir)
+    stops = storage.read_stop_table(auto_dir)
     cells = loopsim.summarize(rows)
 
     started = time.perf_counter()
@@ -174,6 +175,7 @@ def main():
               f"{int((paired['regime'] == paired['regime_check']).sum())}")
     check_s = time.perf_counter() - started
 
+    use_agg()
     save_distribution_figure(cells, rows, os.path.join(args.runs, "summary.png"))
     print(f"\nseeds auto: {len(rows)} runs, {auto_s:.0f} s, "
           f"{rows['wall_s'].sum():.0f} s summed case time; "

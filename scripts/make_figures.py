@@ -80,7 +80,7 @@ import time
 import numpy as np
 import pandas as pd
 
-from loopsim.io import case_order
+from loopsim.storage import case_order
 
 #: The paper's grid (225 loops) and its --quick stand-in (9 loops).
 GRID = ["--g0", "10:350:15", "--theta0", "6:90:15"]

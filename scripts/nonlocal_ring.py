@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-from loopsim.models import nonlocal_circle as closed
+from loopsim.models import nonlocal_closed_form as closed
 from loopsim.models import nonlocal_operator as nl
 
 EPSILONS = (1e-2, 1e-3, 1e-4)

@@ -47,8 +47,9 @@ import sys
 import numpy as np
 import pandas as pd
 
-from loopsim import cli, columns, io, summary
-from loopsim.cli.common import print_and_write, save_distribution_figure
+from loopsim import cli, columns, outcome_statistics, storage
+from loopsim.cli.common import print_and_write, use_agg
+from loopsim.figures import save_distribution_figure
 
 #: The paper's grid: g0 = 10..350 in 15 values, θ0 = 6..90° in 15.
 G0 = np.linspace(10.0, 350.0, 15)
@@ -175,14 +176,14 @@ def main():
         path = os.path.join(args.runs, name)
         if not args.read_only:
             run_part(path, g0, theta0, args.threads, args.max_seeds, args.quick)
-        elif not os.path.isfile(os.path.join(path, io.STOPS_FILE)):
+        elif not os.path.isfile(os.path.join(path, storage.STOPS_FILE)):
             print(f"{name}: not finished, left out ({len(g0) * len(theta0)} cells)")
             continue
-        frames.append(io.read_seeds_auto(path).assign(part=name))
-        stops.append(io.read_stop_table(path).assign(part=name))
-        check = os.path.join(path, io.CHECK_DIR)
+        frames.append(storage.read_seeds_auto(path).assign(part=name))
+        stops.append(storage.read_stop_table(path).assign(part=name))
+        check = os.path.join(path, storage.CHECK_DIR)
         if os.path.isdir(check):
-            checks.append(io.read_results(check))
+            checks.append(storage.read_results(check))
     if not frames:  # --read-only before any part has finished
         sys.exit(f"paper_range_study: no part has finished in {args.runs!r} (no stop table "
                  "yet): nothing to tabulate")
@@ -190,7 +191,7 @@ def main():
     stop = pd.concat(stops, ignore_index=True).drop(columns="part")
     stop["n"] = stop["n"].astype("int64")
     check_rows = pd.concat(checks, ignore_index=True) if checks else pd.DataFrame()
-    table = summary.summarize(frame.drop(columns="part"))
+    table = outcome_statistics.summarize(frame.drop(columns="part"))
     os.makedirs(args.data, exist_ok=True)
     meta = dict(summary_of=" + ".join(sorted(set(frame["part"]))))
     shown = ["g0", "theta0_deg", "seeds", "determined", "p_stable", "p_in_plane", "p_3d",
@@ -225,6 +226,7 @@ def main():
           + ", ".join(f"{k} {v}" for k, v in likeliest.value_counts().items()))
     print("\n".join(steady_lines(table)))
     if args.figure:
+        use_agg()
         save_distribution_figure(table, frame.drop(columns="part"), args.figure, dpi=FIGURE_DPI)
         print(f"figure: {args.figure}")
 

@@ -4,7 +4,7 @@ import sys
 import numpy as np
 import pytest
 
-sys.path.insert(0, os.path.dirname(__file__))  # for tests/naive.py
+sys.path.insert(0, os.path.dirname(__file__))  # for tests/naive.py and tests/oracles.py
 
 
 @pytest.fixture

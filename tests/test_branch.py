@@ -2,7 +2,7 @@
 the continuation, the stability of the steady shapes, a run started on one, the CLI.
 
 References are independent of the branch code: the circle's in-plane threshold from
-the eigenvalues of its full linearisation (``stability.circle``), the right-hand side
+the eigenvalues of its full linearisation (``stability.full_linear``), the right-hand side
 itself (``loop_velocity`` through ``api.evaluate_maps``), the time integrator
 (``loopsim.simulate``) and invariance under tilting.
 """
@@ -15,7 +15,7 @@ import pytest
 
 import loopsim
 from loopsim import cli, diagnostics, spectral
-from loopsim.stability import branch, circle
+from loopsim.stability import branch, full_linear
 
 N = 6
 Q_MAX = 12.0
@@ -34,7 +34,7 @@ def _nearest(shapes, q):
 
 def test_branch_starts_at_the_circles_in_plane_threshold():
     upper, lower = _halves()
-    q_c = circle.critical_q(N, "in-plane")          # eigenvalue crossing of the circle's J
+    q_c = full_linear.critical_q(N, "in-plane")          # eigenvalue crossing of the circle's J
     assert abs(upper.q_bifurcation - q_c) < 1e-6
     assert abs(upper.q_bifurcation - 8.9011866906) < 1e-6   # docs/stability.md, n = 6
     # both halves leave the circle there: aspect ratio → 1 as q → q_c, q increases on one
@@ -101,11 +101,11 @@ def test_tilted_steady_shape_is_steady_with_the_same_q():
 
 def test_stability_at_the_circle_matches_the_circle_linearisation():
     """First point of the branch = the circle at q_c: in-plane rate 0, out-of-plane rate and
-    all sector sizes as in ``stability.circle`` (2(n-2), 2n+3, 2(n-1))."""
+    all sector sizes as in ``stability.full_linear`` (2(n-2), 2n+3, 2(n-1))."""
     upper, _ = _halves()
     spec = branch.stability(upper.shapes[0], w_spectrum=10.0)
     q_c = upper.shapes[0].q
-    ref = circle.sector_growth_rates([q_c], N)
+    ref = full_linear.sector_growth_rates([q_c], N)
     assert abs(spec["leading_in_plane"].real) < 1e-8
     assert spec["leading_out_of_plane"].real == pytest.approx(ref["out-of-plane"][0], abs=1e-9)
     assert spec["sizes"] == (2 * (N - 2), 2 * N + 3, 2 * (N - 1))
@@ -195,7 +195,7 @@ def test_q_loss_out_of_plane_converges_in_n():
 def test_steady_branch_frame():
     frame = branch.steady_branch(5, 9.6)
     assert list(frame.columns) == list(branch.ROW_FIELDS)
-    assert abs(frame.attrs["q_bifurcation"] - circle.critical_q(5, "in-plane")) < 1e-6
+    assert abs(frame.attrs["q_bifurcation"] - full_linear.critical_q(5, "in-plane")) < 1e-6
     circle_row = frame[frame.side == 0].iloc[0]
     assert circle_row.aspect_ratio == pytest.approx(1.0) and circle_row.q == frame.attrs["q_circle"]
     assert frame[frame.side == 1].stable_in_plane.all()
@@ -206,7 +206,7 @@ def test_cli_json(capsys):
     assert cli.main(["branch", "--n", "5", "--q-max", "10", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert {"q_bifurcation", "q_loss_out_of_plane", "branch"} <= set(out)
-    assert abs(out["q_bifurcation"] - circle.critical_q(5, "in-plane")) < 1e-6
+    assert abs(out["q_bifurcation"] - full_linear.critical_q(5, "in-plane")) < 1e-6
     assert out["q_loss_out_of_plane"] is None          # none below q = 10
     rows = out["branch"]
     for key in ("q", "aspect_ratio", "stable_in_plane", "stable_out_of_plane",

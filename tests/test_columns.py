@@ -47,8 +47,8 @@ def test_every_declaration_has_a_unit_and_a_description(declarations):
 
 
 def test_summary_declarations_cover_every_cell_input_and_regime():
-    from loopsim import outcomes, summary
+    from loopsim import outcome_statistics, outcomes
 
-    assert set(summary.CELL_INPUTS) <= set(columns.SUMMARY_COLUMNS)
+    assert set(outcome_statistics.CELL_INPUTS) <= set(columns.SUMMARY_COLUMNS)
     for regime in outcomes.REGIMES:
         assert f"p_{regime.replace('-', '_')}_high" in columns.SUMMARY_COLUMNS

@@ -13,11 +13,11 @@ import pyarrow.parquet as pq
 import pytest
 
 import loopsim
-from loopsim import io, sweeps
+from loopsim import storage, sweeps
 from loopsim.cli import main
-from loopsim.config import DEFAULT_AUTO_CHUNK_SIZE
+from loopsim.defaults import DEFAULT_AUTO_CHUNK_SIZE
 
-DETERMINISTIC = [c for c in io.RESULT_SCHEMA.names if c != "wall_s"]
+DETERMINISTIC = [c for c in storage.RESULT_SCHEMA.names if c != "wall_s"]
 
 
 def small_config(**kwargs):
@@ -89,8 +89,14 @@ def test_auto_sweep_names_n_max_for_unresolved_cases(tmp_path, capsys):
 
 def test_ensemble_is_the_sweeps_package_under_its_earlier_name():
     """``loopsim.ensemble`` (sweeps' module until they became the package
-    ``loopsim.sweeps``) re-exports every public name of the package, unchanged."""
-    from loopsim import ensemble
+    ``loopsim.sweeps``) re-exports every public name of the package, unchanged, and warns
+    that it is deprecated."""
+    import importlib
+    import sys
+
+    sys.modules.pop("loopsim.ensemble", None)
+    with pytest.warns(DeprecationWarning, match="loopsim.ensemble"):
+        ensemble = importlib.import_module("loopsim.ensemble")
 
     assert sorted(ensemble.__all__) == sorted(sweeps.__all__)
     for name in sweeps.__all__:
@@ -114,7 +120,7 @@ def test_sweep_schema_round_trip_and_thread_reproducibility(tmp_path):
     assert list(one["case_id"]) == list(range(6))
     pd.testing.assert_frame_equal(one[DETERMINISTIC], two[DETERMINISTIC], check_exact=True)
     for path in (tmp_path / "one").glob("chunk-*.parquet"):
-        assert pq.read_schema(path).remove_metadata() == io.RESULT_SCHEMA
+        assert pq.read_schema(path).remove_metadata() == storage.RESULT_SCHEMA
     meta = one.attrs["loopsim"]
     assert meta["sweep_config"]["t_end"] == 0.5 and meta["thresholds"]["tilt_change_deg"] == 1.0
     assert meta["loopsim_version"] == loopsim.__version__
@@ -136,7 +142,7 @@ def test_batch_kernel_gives_the_same_bits_on_any_number_of_lanes():
     n, cases = 4, [(10.0, 30.0), (150.0, 60.0), (60.0, 85.0)]
     x0 = np.array([shapes.start_shape(theta, n, 1e-3, 0)[0].ravel() for _, theta in cases])
     options = integrators.step_options(1e-6, 1e-9, max_steps=200_000, constraint_tol=0.25)
-    runs = [batch.integrate_cases(integrators.METHODS["rkf45"], models.local_sbt.make_operators(n),
+    runs = [batch.integrate_batch(integrators.METHODS["rkf45"], models.local_sbt.make_operators(n),
                                   [(g0, 10.0) for g0, _ in cases], x0, 0.3, options,
                                   cost=[1.0, 3.0, 2.0], lanes=lanes)
             for lanes in (1, 2, 3)]

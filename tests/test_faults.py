@@ -16,10 +16,10 @@ import pyarrow.parquet as pq
 import pytest
 
 import loopsim
-from loopsim import io, sweeps, validation
+from loopsim import storage, sweeps, validation
 from loopsim.cli import main
 
-DETERMINISTIC = [c for c in io.RESULT_SCHEMA.names if c != "wall_s"]
+DETERMINISTIC = [c for c in storage.RESULT_SCHEMA.names if c != "wall_s"]
 
 
 def _config():
@@ -90,7 +90,7 @@ def _damage(path, how):
 def test_damaged_result_file_is_reported_then_recomputed(sweep, pristine, capsys, how):
     """read_results names the damaged file in one line; the sweep's command moves it to
     _quarantine/ with a one-line warning and recomputes exactly its cases."""
-    name = io.CHUNK_PATTERN.format(0, 1)
+    name = storage.CHUNK_PATTERN.format(0, 1)
     _damage(os.path.join(sweep, name), how)
     with pytest.raises(ValueError) as error:
         loopsim.read_results(sweep)
@@ -108,7 +108,7 @@ def test_damaged_result_file_is_reported_then_recomputed(sweep, pristine, capsys
 
 
 def test_damaged_snapshot_file_recomputes_its_piece(sweep, pristine):
-    snapshots = os.path.join(sweep, io.SNAPSHOT_DIR, io.CHUNK_PATTERN.format(1, 2))
+    snapshots = os.path.join(sweep, storage.SNAPSHOT_DIR, storage.CHUNK_PATTERN.format(1, 2))
     _silent_flip(snapshots, "x")
     with pytest.raises(ValueError, match="damaged"):
         loopsim.read_snapshots(sweep)
@@ -123,7 +123,7 @@ def test_damaged_snapshot_file_recomputes_its_piece(sweep, pristine):
 def test_random_bit_flips_are_detected_or_harmless(sweep, pristine):
     """40 random single-bit flips of one result file: each is detected or changes no value
     that read_results returns (flips in unused statistics or padding)."""
-    path = os.path.join(sweep, io.CHUNK_PATTERN.format(1, 2))
+    path = os.path.join(sweep, storage.CHUNK_PATTERN.format(1, 2))
     original = open(path, "rb").read()
     rng = np.random.default_rng(14)
     outcomes = []
@@ -150,9 +150,9 @@ def test_every_footer_byte_flip_is_damage_or_harmless(sweep):
     uses (the checked table and the footer's metadata); never another exception (a flip in
     the nested names of ``x_final`` raised a bare UnicodeDecodeError from
     ``ParquetFile.column_paths``), never a silent change."""
-    path = os.path.join(sweep, io.CHUNK_PATTERN.format(0, 1))
+    path = os.path.join(sweep, storage.CHUNK_PATTERN.format(0, 1))
     original = open(path, "rb").read()
-    expected, expected_meta = io.read_table_checked(path), io.read_metadata(path)
+    expected, expected_meta = storage.read_table_checked(path), storage.read_metadata(path)
     footer = int.from_bytes(original[-8:-4], "little")
     outcomes = {"harmless": 0, "damaged": 0}
     flips = [(offset, 7) for offset in range(len(original) - 8 - footer, len(original) - 8)]
@@ -163,8 +163,8 @@ def test_every_footer_byte_flip_is_damage_or_harmless(sweep):
         with open(path, "wb") as handle:
             handle.write(bytes(data))
         try:
-            table, meta = io.read_table_checked(path, True), io.read_metadata(path)
-        except io.DamagedFile as damaged:
+            table, meta = storage.read_table_checked(path, True), storage.read_metadata(path)
+        except storage.DamagedFile as damaged:
             assert damaged.path == path and path in str(damaged), (offset, bit)
             outcomes["damaged"] += 1
             continue
@@ -180,7 +180,7 @@ def test_undecodable_nested_name_is_damage_named_and_quarantined(sweep, pristine
     """The flip that escaped (a non-UTF-8 byte in ``x_final``'s nested list names): every
     reader names the file as damaged in one line, and the resume quarantines and
     recomputes it."""
-    name = io.CHUNK_PATTERN.format(0, 1)
+    name = storage.CHUNK_PATTERN.format(0, 1)
     path = os.path.join(sweep, name)
     original = open(path, "rb").read()
     footer = original[len(original) - 8 - int.from_bytes(original[-8:-4], "little"):]
@@ -199,16 +199,16 @@ def test_undecodable_nested_name_is_damage_named_and_quarantined(sweep, pristine
             "--threads", "1", "--out", sweep]
     assert main(argv) == 0
     assert name in capsys.readouterr().err
-    assert len(os.listdir(os.path.join(sweep, io.QUARANTINE_DIR))) == 1
+    assert len(os.listdir(os.path.join(sweep, storage.QUARANTINE_DIR))) == 1
     _same_rows(loopsim.read_results(sweep), pristine[1])
 
 
 def test_file_without_its_checksum_is_damaged(sweep):
     """A result file rewritten without the content hash (or a flip that hid its key) is
     not trusted in a sweep that writes checksums."""
-    path = os.path.join(sweep, io.CHUNK_PATTERN.format(0, 1))
+    path = os.path.join(sweep, storage.CHUNK_PATTERN.format(0, 1))
     table = pq.read_table(path)
-    meta = {k: v for k, v in table.schema.metadata.items() if k != io.CONTENT_KEY.encode()}
+    meta = {k: v for k, v in table.schema.metadata.items() if k != storage.CONTENT_KEY.encode()}
     pq.write_table(table.replace_schema_metadata(meta), path)
     with pytest.raises(ValueError, match="no content_sha256"):
         loopsim.read_results(sweep)
@@ -218,7 +218,7 @@ def test_page_checksums_are_written_and_verified(tmp_path):
     """Without the content hash, the Parquet page CRCs alone catch a flipped data byte."""
     path = str(tmp_path / "t.parquet")
     table = pa.table({"v": np.arange(256, dtype=np.float64)})
-    io.write_table_atomically(table, path)
+    storage.write_table_atomically(table, path)
     assert pq.ParquetFile(path).metadata.row_group(0).column(0).total_compressed_size > 0
     plain = str(tmp_path / "plain.parquet")
     pq.write_table(table, plain, write_page_checksum=True, compression="none")
@@ -226,17 +226,17 @@ def test_page_checksums_are_written_and_verified(tmp_path):
     data[200] ^= 1  # inside the values of the only data page
     open(plain, "wb").write(bytes(data))
     assert not pq.read_table(plain).column("v").equals(table.column("v"))  # silent without
-    with pytest.raises(io.DamagedFile, match="unreadable"):
-        io.read_table_checked(plain)
+    with pytest.raises(storage.DamagedFile, match="unreadable"):
+        storage.read_table_checked(plain)
 
 
 def test_content_hash_ignores_layout_not_values():
     table = pa.table({"a": [1.0, 2.0, 3.0], "x": [[1.0], [2.0, 3.0], []]})
     chunked = pa.concat_tables([table.slice(0, 1), table.slice(1)])
-    assert io.content_hash(chunked, {}) == io.content_hash(table, {})
+    assert storage.content_hash(chunked, {}) == storage.content_hash(table, {})
     changed = table.set_column(0, "a", pa.array([1.0, 2.0, 3.0000000000000004]))
-    assert io.content_hash(changed, {}) != io.content_hash(table, {})
-    assert io.content_hash(table, {"k": "v"}) != io.content_hash(table, {"k": "w"})
+    assert storage.content_hash(changed, {}) != storage.content_hash(table, {})
+    assert storage.content_hash(table, {"k": "v"}) != storage.content_hash(table, {"k": "w"})
 
 
 def test_damaged_initial_results_are_refused(tmp_path, capsys):
@@ -252,7 +252,7 @@ def test_damaged_initial_results_are_refused(tmp_path, capsys):
 
 
 def test_damaged_chunk_as_initial_is_refused(sweep, capsys):
-    path = os.path.join(sweep, io.CHUNK_PATTERN.format(1, 2))
+    path = os.path.join(sweep, storage.CHUNK_PATTERN.format(1, 2))
     _silent_flip(path, "x_final")
     assert main(["run", "--n", "6", "--initial", path, "--t-end", "0.01"]) == 2
     assert "damaged" in capsys.readouterr().err
@@ -280,7 +280,7 @@ def test_damaged_run_file_is_refused_by_animate_and_figures(sweep, tmp_path, cap
 def test_damaged_parquet_cases_file_is_refused(tmp_path, capsys):
     """Issue 46.1: a cases file loopsim wrote (with checksums) is read checked too."""
     path = str(tmp_path / "cases.parquet")
-    io.write_table_atomically(pa.table({"g0": np.linspace(10.0, 60.0, 50),
+    storage.write_table_atomically(pa.table({"g0": np.linspace(10.0, 60.0, 50),
                                         "theta0_deg": np.full(50, 30.0)}), path)
     _silent_flip(path, "g0")
     assert main(["sweep", "--n", "4", "--cases", path, "--out", str(tmp_path / "s")]) == 2
@@ -385,10 +385,10 @@ def test_a_case_given_twice_is_refused_before_anything_is_written(tmp_path, caps
 def test_refused_rerun_options_leave_the_directory_usable(sweep, capsys):
     """An invalid --rtol or --atol of --rerun-failed is refused before anything is
     recorded in _sweep.json, so a later valid rerun is not blocked by it."""
-    before = open(os.path.join(sweep, io.SWEEP_FILE)).read()
+    before = open(os.path.join(sweep, storage.SWEEP_FILE)).read()
     for bad in (["--rtol", "0"], ["--atol", "-1"]):
         assert main(["sweep", "--rerun-failed", sweep, "--quiet"] + bad) == 2
-        assert open(os.path.join(sweep, io.SWEEP_FILE)).read() == before
+        assert open(os.path.join(sweep, storage.SWEEP_FILE)).read() == before
     assert main(["sweep", "--rerun-failed", sweep, "--method", "radau5", "--quiet"]) == 0
 
 
@@ -397,11 +397,11 @@ def test_refused_rerun_options_leave_the_directory_usable(sweep, capsys):
 def test_rerun_refuses_every_option_it_would_ignore(sweep, capsys, option):
     """Issue 36.6: --model and --slenderness (any value, 0 included) are refused like every
     other option that is not --method, --rtol or --atol, and nothing is recorded."""
-    before = open(os.path.join(sweep, io.SWEEP_FILE)).read()
+    before = open(os.path.join(sweep, storage.SWEEP_FILE)).read()
     assert main(["sweep", "--rerun-failed", sweep, "--method", "radau5", *option]) == 2
     err = capsys.readouterr().err
     assert f"{option[0]} does not apply with --rerun-failed" in err, err
-    assert open(os.path.join(sweep, io.SWEEP_FILE)).read() == before
+    assert open(os.path.join(sweep, storage.SWEEP_FILE)).read() == before
 
 
 def test_cases_file_slenderness_of_a_local_row_is_refused(tmp_path, capsys):
@@ -451,9 +451,9 @@ def _handler_installed(pid, signum):
 
 def _integrating(pid):
     """Whether process ``pid`` runs its integration thread (named
-    ``stopping.NATIVE_THREAD_NAME`` in /proc/PID/task/TID/comm): then the command's own
+    ``signals.NATIVE_THREAD_NAME`` in /proc/PID/task/TID/comm): then the command's own
     signal handling is in place, however long loading and compiling took."""
-    from loopsim.sweeps.stopping import NATIVE_THREAD_NAME
+    from loopsim.sweeps.signals import NATIVE_THREAD_NAME
 
     for task in os.listdir(f"/proc/{pid}/task"):
         try:
@@ -526,7 +526,7 @@ def test_run_out_removes_temporaries_of_killed_runs_only(tmp_path, capsys):
     assert main(["run", "--g0", "60", "--theta0", "30", "--n", "4", "--t-end", "0.05",
                  "--out", str(out)]) == 0
     assert out.exists() and live.exists() and not dead.exists()
-    io.read_table_checked(str(out), require_hash=True)
+    storage.read_table_checked(str(out), require_hash=True)
 
 
 def _dead_pid():
@@ -582,7 +582,7 @@ def test_the_next_write_removes_temporaries_of_dead_writers(tmp_path, capsys):
 
 def test_edited_sweep_file_is_damaged(sweep):
     """A flipped value in _sweep.json's configuration no longer matches its fingerprint."""
-    path = os.path.join(sweep, io.SWEEP_FILE)
+    path = os.path.join(sweep, storage.SWEEP_FILE)
     text = open(path).read()
     assert '"t_end": 0.2' in text
     open(path, "w").write(text.replace('"t_end": 0.2', '"t_end": 0.3'))
@@ -593,16 +593,16 @@ def test_edited_sweep_file_is_damaged(sweep):
 def test_lost_sidecar_and_damaged_file_repaired_together(sweep, pristine):
     """_sweep.json lost and a result file truncated: the same sweep restores the one and
     recomputes the other; a stray copy is ignored with a warning, never merged."""
-    os.remove(os.path.join(sweep, io.SWEEP_FILE))
-    os.truncate(os.path.join(sweep, io.CHUNK_PATTERN.format(1, 2)), 100)
-    shutil.copy(os.path.join(sweep, io.CHUNK_PATTERN.format(0, 1)),
+    os.remove(os.path.join(sweep, storage.SWEEP_FILE))
+    os.truncate(os.path.join(sweep, storage.CHUNK_PATTERN.format(1, 2)), 100)
+    shutil.copy(os.path.join(sweep, storage.CHUNK_PATTERN.format(0, 1)),
                 os.path.join(sweep, "chunk-0000000-0000001 (copy).parquet"))
     with pytest.warns(UserWarning) as caught:
         frame = sweeps.run_sweep(_config(), sweep, threads=1, quiet=True)
     messages = [str(w.message) for w in caught]
     assert any("damaged" in m for m in messages) and any("stray copy" in m for m in messages)
     _same_rows(frame, pristine[1])
-    assert io.read_sweep_file(sweep)["checksums"] == io.CONTENT_KEY
+    assert storage.read_sweep_file(sweep)["checksums"] == storage.CONTENT_KEY
 
 
 def test_disk_full_is_an_environment_error_and_the_sweep_resumes(tmp_path, capsys, monkeypatch):

@@ -146,13 +146,13 @@ def test_figures_of_n_auto_rows_read_the_coefficients_at_n_used():
 def test_phase_diagram_of_n_auto_rows_names_n_used_and_draws_its_linearisation():
     """An --n auto table is titled by the orders reached, not by the ladder's start, and its
     full-linearisation curves are those of the largest n_used."""
-    from loopsim.stability import circle
+    from loopsim.stability import full_linear
 
     title = figures.phase_diagram(auto_table()).axes[0].get_title()
     assert f"n auto (n_used = {N}, {N + 2})" in title
     assert f"n = {N}," in figures.phase_diagram(table()).axes[0].get_title()
     labels = [t.get_text() for t in figures.phase_diagram(auto_table()).axes[0].get_legend().get_texts()]
-    q_in_plane = circle.critical_q(N + 2, "in-plane")
+    q_in_plane = full_linear.critical_q(N + 2, "in-plane")
     assert any(f"q = {q_in_plane:.3f}" in text for text in labels)
 
 
@@ -161,19 +161,19 @@ def test_nonlocal_tables_draw_their_models_thresholds_side_by_side():
     thresholds (θ0 = 90°) and name ε; one outcome column per table; mixing models in one
     table is refused."""
     from loopsim import models
-    from loopsim.stability import circle
+    from loopsim.stability import full_linear
 
     local = table()
     nonlocal_table = table().assign(model="nonlocal", slenderness=1e-3)
     model = models.choose("nonlocal", 1e-3)
-    q_in = circle.critical_q(N, "in-plane", model=model)
+    q_in = full_linear.critical_q(N, "in-plane", model=model)
     fig = figures.phase_diagram(nonlocal_table)
     assert "ε = 0.001" in fig.axes[0].get_title()
     assert any(f"q = {q_in:.3f}" in t.get_text() for t in fig.axes[0].get_legend().get_texts())
     fig = figures.model_outcomes([local, nonlocal_table])
     assert len(fig.axes) == 4
     lines = lambda ax: sorted(round(line.get_xdata()[0], 6) for line in ax.get_lines())
-    assert lines(fig.axes[2]) == sorted(round(circle.critical_q(N, s), 6)
+    assert lines(fig.axes[2]) == sorted(round(full_linear.critical_q(N, s), 6)
                                         for s in ("in-plane", "out-of-plane"))
     assert round(q_in, 6) in lines(fig.axes[3])
     assert "nonlocal SBT, ε = 0.001" in fig.axes[1].get_title()

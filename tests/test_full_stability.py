@@ -1,4 +1,4 @@
-"""Tests for loopsim.stability.circle: the Jacobian of loopsim's own RHS about the
+"""Tests for loopsim.stability.full_linear: the Jacobian of loopsim's own RHS about the
 translating circle, its neutral modes, sectors, thresholds and the comparison
 with the paper's operator.
 
@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from loopsim import api, shapes
-from loopsim.stability import circle as fs
+from loopsim.stability import full_linear as fs
 from loopsim.stability import onset, paper
 from loopsim.cli import main
 

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from loopsim import api, integrators
-from loopsim.config import DEFAULT_LENGTH_TOL
+from loopsim.defaults import DEFAULT_LENGTH_TOL
 from loopsim.stability import paper
 
 METHODS = sorted(integrators.METHODS)

@@ -8,7 +8,7 @@ import pytest
 from scipy import integrate, special
 
 import loopsim
-from loopsim import api, io, shapes, spectral, sweeps
+from loopsim import api, shapes, spectral, storage, sweeps
 from loopsim.cli import main
 
 EXAMPLE = os.path.join(os.path.dirname(__file__), os.pardir, "data", "wobbly_ellipse.csv")
@@ -111,7 +111,7 @@ TIGHT = dict(rtol=1e-10, atol=1e-13)
 def test_continuation_equals_one_longer_run(tmp_path, capsys):
     first = api.simulate(60, 30, n=6, t_span=(0, 1.0), **TIGHT)
     path = str(tmp_path / "first.parquet")
-    io.write_trajectory(first, path)
+    storage.write_trajectory(first, path)
     x, info = shapes.load_initial(path)
     assert np.array_equal(x, first.x_final)  # exact: stored coefficients, no resampling
     assert info["kind"] == "run" and info["g0"] == 60 and info["t_final"] == 1.0
@@ -225,7 +225,7 @@ def test_bad_point_files(which, tmp_path, capsys):
 def test_bad_case_ids_and_flag_combinations(tmp_path, capsys):
     run = api.simulate(10, 30, n=4, t_span=(0, 0.01))
     path = str(tmp_path / "run.parquet")
-    io.write_trajectory(run, path)
+    storage.write_trajectory(run, path)
     points = write_points(tmp_path / "p.csv", _circle(40))
     sweep = str(tmp_path / "sweep")
     sweeps.run_sweep(sweeps.SweepConfig(
@@ -247,9 +247,9 @@ def test_n_auto_starts_a_point_file_at_the_order_its_content_needs(tmp_path, cap
     """``--initial POINTS --n auto``: a perturbed tilted circle sampled at 256 equally
     spaced parameter values (not arc length: refitted by arc length, its content above
     order 6 is about 5e-5 of its RMS amplitude) starts at the lowest order whose
-    truncation leaves out at most config.INITIAL_CONTENT_TOL, not at order 6, and every
+    truncation leaves out at most defaults.INITIAL_CONTENT_TOL, not at order 6, and every
     order of the ladder starts from that same shape (exactly zero-padded)."""
-    from loopsim import config
+    from loopsim import defaults
 
     x = shapes.initial_shape(6, np.radians(45.0), 1e-3, 3)
     s = np.linspace(0.0, 2.0 * np.pi, 256, endpoint=False)
@@ -257,8 +257,8 @@ def test_n_auto_starts_a_point_file_at_the_order_its_content_needs(tmp_path, cap
     assert shapes.load_initial(path, 6)[1]["truncation"] > 1e-6  # content above order 6
     order = shapes.auto_start_order(path)
     start, info = shapes.load_initial(path, order)
-    assert order > 6 and info["truncation"] <= config.INITIAL_CONTENT_TOL
-    assert shapes.load_initial(path, order - 1)[1]["truncation"] > config.INITIAL_CONTENT_TOL
+    assert order > 6 and info["truncation"] <= defaults.INITIAL_CONTENT_TOL
+    assert shapes.load_initial(path, order - 1)[1]["truncation"] > defaults.INITIAL_CONTENT_TOL
     assert shapes.auto_start_order(path, high=8) == 8  # never above the ladder's top
     result = api.simulate(60.0, None, initial=path, t_span=(0.0, 0.05), twin=False)
     assert result.inputs["n"] == order == result.initial_info["n"]

@@ -18,7 +18,7 @@ def test_cache_directory_follows_the_source(tmp_path):
     # must an edit to a module a kernel module imports (local_sbt imports spectral)
     sources = [p.replace("\\", "/") for p in _jitcache.kernel_sources()]
     for module in ("integrators/driver.py", "integrators/radau.py", "models/local_sbt.py",
-                   "linalg.py", "batch.py", "spectral.py", "config.py"):
+                   "linalg.py", "batch.py", "spectral.py", "defaults.py", "jit.py"):
         assert any(p.endswith("loopsim/" + module) for p in sources), module
     # orchestration that no kernel imports does not invalidate the compiled kernels
     for module in ("cli/__init__.py", "cli/sweep.py", "ensemble.py", "sweeps/runner.py",

@@ -8,7 +8,7 @@ Every import statement counts, including those inside functions.  An import
 (a submodule), otherwise to ``P`` (a name defined in ``P``), so
 ``from .base import y`` in loopsim/models/local_sbt.py is an edge to
 loopsim.models.base and ``from . import circle`` in loopsim/stability/onset.py
-one to loopsim.stability.circle.
+one to loopsim.stability.full_linear.
 
 A private name is one with a single leading underscore (dunders are public).
 Private functions, classes and variables may be used only inside the module
@@ -24,9 +24,18 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 PACKAGE = "loopsim"
 
 #: Client files allowed to import one private loopsim module, to unit-test it.
-PRIVATE_MODULE_UNIT_TESTS = {"tests/test_jitcache.py": {"loopsim._jitcache"}}
+PRIVATE_MODULE_UNIT_TESTS = {"tests/test_jitcache.py": {"loopsim._jitcache"},
+                             "tests/test_moved.py": {"loopsim._moved"}}
 #: The most physical lines a module of the package may have (issue 23, "Layout").
 MAX_MODULE_LINES = 500
+#: The most lines of code (not blank, not comments, not the docstring) a function may have
+#: (issue 45): a screen.  Numba kernels are exempt (splitting one may change its compiled
+#: numerics), and so is a function whose docstring says why it is longer ("Longer than a
+#: screen: ...").
+MAX_FUNCTION_LINES = 60
+#: Decorators that make a function a Numba kernel (``jit.kernel``, ``jit.entry``,
+#: ``dispatch.implements``, Numba's own).
+KERNEL_DECORATORS = ("kernel", "entry", "implements", "njit", "jit", "overload", "intrinsic")
 
 
 # ---- reading the package ------------------------------------------------------------
@@ -237,6 +246,104 @@ def test_clients_use_no_private_loopsim_names(folder):
             offenders += private_uses(None, False, tree, known, where,
                                       PRIVATE_MODULE_UNIT_TESTS.get(where, ()))
     assert not offenders, f"private loopsim names used in {folder}/:\n" + _format(offenders)
+
+
+def code_lines(lines, node):
+    """Lines of code of a function node: not blank, not comment-only, docstring left out."""
+    body = node.body
+    first = body[0]
+    docstring = (isinstance(first, ast.Expr) and isinstance(first.value, ast.Constant)
+                 and isinstance(first.value.value, str))
+    if docstring and len(body) == 1:
+        return 0
+    start = body[1].lineno if docstring else first.lineno
+    return sum(1 for line in lines[start - 1:node.end_lineno]
+               if line.strip() and not line.strip().startswith("#"))
+
+
+def is_kernel(node):
+    for decorator in node.decorator_list:
+        target = decorator.func if isinstance(decorator, ast.Call) else decorator
+        name = target.attr if isinstance(target, ast.Attribute) else getattr(target, "id", "")
+        if name in KERNEL_DECORATORS:
+            return True
+    return False
+
+
+def test_no_function_is_longer_than_a_screen():
+    """Every function of the package outside Numba kernels has at most
+    MAX_FUNCTION_LINES lines of code, or says in its docstring why not."""
+    over = []
+    for name, (path, _) in sorted(package_modules().items()):
+        text = _read(path)
+        lines = text.splitlines()
+        for node in ast.walk(ast.parse(text, filename=path)):
+            if not isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)) or is_kernel(node):
+                continue
+            count = code_lines(lines, node)
+            if count > MAX_FUNCTION_LINES and \
+                    "Longer than a screen:" not in (ast.get_docstring(node) or ""):
+                over.append(f"  {os.path.relpath(path, ROOT)}:{node.lineno} {node.name}: "
+                            f"{count} lines")
+    assert not over, (f"functions over {MAX_FUNCTION_LINES} lines of code (split them along "
+                      "their steps):\n" + "\n".join(over))
+
+
+def test_code_lines_count_what_they_say():
+    source = ('def f():\n    """Doc\n\n    more."""\n    a = 1\n\n    # note\n    return a\n'
+              "def g():\n    return 2\n")
+    tree = ast.parse(source)
+    lines = source.splitlines()
+    assert [code_lines(lines, node) for node in tree.body] == [2, 1]
+    kernel = ast.parse("@kernel\ndef k():\n    pass\n@numba.njit(cache=True)\ndef j():\n"
+                       "    pass\ndef p():\n    pass\n")
+    assert [is_kernel(node) for node in kernel.body] == [True, True, False]
+
+
+def _layers():
+    """The layers named in loopsim/__init__.py's docstring (scripts/module_table.py)."""
+    return module_table_script().layers()
+
+
+def module_table_script():
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location(
+        "module_table", os.path.join(ROOT, "scripts", "module_table.py"))
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_layer_list_names_every_module_once_and_imports_go_up_only():
+    """loopsim/__init__.py names every top-level module and subpackage in its list of
+    layers, once; every import goes to a module of an earlier layer."""
+    layer_of = {}
+    for number, names in enumerate(_layers()):
+        for name in names:
+            assert name not in layer_of, f"{name} named twice"
+            layer_of[name] = number
+    modules = package_modules()
+    top = {m.split(".")[1] for m in modules if m != PACKAGE}
+    assert set(layer_of) == top, (f"not named: {sorted(top - set(layer_of))}; "
+                                  f"no such module: {sorted(set(layer_of) - top)}")
+    sources = {name: (_read(path), is_package) for name, (path, is_package) in modules.items()}
+    upward = []
+    for module, targets in import_graph(sources, set(modules)).items():
+        if module == PACKAGE:
+            continue
+        here = module.split(".")[1]
+        for target in targets:
+            there = target.split(".")[1] if target != PACKAGE else None
+            if there is not None and there != here and layer_of[there] >= layer_of[here]:
+                upward.append(f"  {module} imports {target} (layer {layer_of[there] + 1} >= "
+                              f"{layer_of[here] + 1})")
+    assert not upward, "imports of a module not in an earlier layer:\n" + "\n".join(upward)
+
+
+def test_extending_md_module_table_is_current():
+    assert module_table_script().main(["--check"]) == 0, \
+        "docs/extending.md's module table is stale: run python scripts/module_table.py"
 
 
 # ---- the checker itself, on synthetic sources ---------------------------------------

@@ -23,7 +23,7 @@ from scipy import integrate
 
 import naive
 from loopsim import spectral
-from loopsim.models import nonlocal_circle as closed
+from loopsim.models import nonlocal_closed_form as closed
 from loopsim.models import nonlocal_operator as nl
 from loopsim.shapes import inclined_circle
 

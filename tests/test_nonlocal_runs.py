@@ -9,9 +9,9 @@ import pyarrow as pa
 import pytest
 
 import loopsim
-from loopsim import integrators, io, models, shapes, sweeps
+from loopsim import integrators, models, shapes, storage, sweeps
 from loopsim.cli import main
-from loopsim.models import nonlocal_circle as closed
+from loopsim.models import nonlocal_closed_form as closed
 from loopsim.models import nonlocal_sbt
 
 NONLOCAL = dict(model="nonlocal", slenderness=1e-3)
@@ -57,7 +57,7 @@ def test_sweep_rows_record_the_model_and_equal_single_runs(tmp_path):
     one = sweeps.run_sweep(config, str(tmp_path / "one"), threads=1, quiet=True)
     two = sweeps.run_sweep(config, str(tmp_path / "two"), threads=2, quiet=True)
     assert set(one["model"]) == {"nonlocal"} and set(one["slenderness"]) == {1e-3}
-    assert io.RESULT_SCHEMA.field("slenderness").metadata[b"unit"] == b"1"
+    assert storage.RESULT_SCHEMA.field("slenderness").metadata[b"unit"] == b"1"
     for a, b in zip(one["x_final"], two["x_final"]):
         np.testing.assert_array_equal(a, b)
     single = loopsim.simulate(40.0, 60.0, n=6, t_span=(0.0, 0.3), steady_tol=1e-6, twin=False,
@@ -123,11 +123,11 @@ def test_bad_model_options_are_one_line_errors(argv, words, capsys, tmp_path):
 
 def test_result_files_written_before_the_model_columns_read_as_local():
     """A row of a file without the columns model and slenderness is a local-model row."""
-    table = io.RESULT_SCHEMA.empty_table().drop_columns(["model", "slenderness"])
+    table = storage.RESULT_SCHEMA.empty_table().drop_columns(["model", "slenderness"])
     row = {name: [None] for name in table.schema.names}
     table = pa.table(row, schema=table.schema)
-    read = io.sweepdir.result_table(table)
-    assert read.schema.equals(io.RESULT_SCHEMA)
+    read = storage.sweepdir.result_table(table)
+    assert read.schema.equals(storage.RESULT_SCHEMA)
     assert read.column("model").to_pylist() == ["local"]
     assert read.column("slenderness").to_pylist() == [None]
 

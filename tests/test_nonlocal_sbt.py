@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from loopsim import integrators, shapes
-from loopsim.models import nonlocal_circle as closed
+from loopsim.models import nonlocal_closed_form as closed
 from loopsim.models import nonlocal_operator as nl
 from loopsim.models import nonlocal_sbt
 

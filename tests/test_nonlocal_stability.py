@@ -1,5 +1,5 @@
 """The translating circle under nonlocal slender-body theory: still a steady solution,
-its Jacobian, and its linear stability against ε (``stability.circle`` with
+its Jacobian, and its linear stability against ε (``stability.full_linear`` with
 ``model=``; docs/nonlocal.md, "The translating circle")."""
 import json
 import math
@@ -7,10 +7,12 @@ import math
 import numpy as np
 import pytest
 
+import oracles
+
 from loopsim import api, models, shapes
 from loopsim.cli import main
-from loopsim.models import nonlocal_circle as closed
-from loopsim.stability import circle
+from loopsim.models import nonlocal_closed_form as closed
+from loopsim.stability import full_linear
 
 LOCAL_IN_PLANE, LOCAL_OUT_OF_PLANE = 8.900090534313328, 10.649315608483457
 
@@ -33,12 +35,12 @@ def test_the_tilted_circle_translates_rigidly_at_johnson_wu_mobilities(eps, thet
 
 
 def test_difference_jacobian_matches_the_exact_local_one(rng):
-    """models.difference_jacobian (central differences) against the exact local Jacobian
+    """oracles.difference_jacobian (central differences) against the exact local Jacobian
     at a deformed, tilted loop: 1e-7 relative to its largest entry."""
     x = shapes.inclined_circle(6, 0.7) + 0.05 * rng.standard_normal((3, 13))
-    exact = circle.rhs_jacobian(x, 40.0)
+    exact = full_linear.rhs_jacobian(x, 40.0)
     problem = models.make_problem(models.LOCAL, 6, 40.0, 10.0)
-    approx = models.difference_jacobian(problem, x.ravel())
+    approx = oracles.difference_jacobian(problem, x.ravel())
     assert np.abs(approx - exact).max() < 1e-7 * np.abs(exact).max()
 
 
@@ -51,8 +53,8 @@ def test_exact_nonlocal_jacobian_matches_central_differences_of_the_compiled_rhs
     model = models.choose("nonlocal", eps)
     x = shapes.inclined_circle(6, 0.7) + 0.05 * rng.standard_normal((3, 13))
     problem = models.make_problem(model, 6, 40.0, 10.0)
-    exact = circle.rhs_jacobian(x, 40.0, model=model)
-    central = models.difference_jacobian(problem, x.ravel())
+    exact = full_linear.rhs_jacobian(x, 40.0, model=model)
+    central = oracles.difference_jacobian(problem, x.ravel())
     assert np.abs(exact - central).max() < 1e-7 * np.abs(central).max()
 
 
@@ -64,12 +66,12 @@ def test_nonlocal_thresholds_converge_in_n_and_the_sectors_decouple(eps, in_plan
     decouple exactly (1e-12).  The thresholds at n = 8 and 10 agree to 1e-6 (the values
     are docs/nonlocal.md's table, to its six decimals)."""
     model = models.choose("nonlocal", eps)
-    lin = circle.linearise_circle(10, 30.0, 90.0, model=model)
+    lin = full_linear.linearise_circle(10, 30.0, 90.0, model=model)
     assert lin.diagnostics["in_to_out_coupling"] < 1e-12
     assert lin.diagnostics["out_to_in_coupling"] < 1e-12
     assert lin.diagnostics["neutral_leak"] < 1e-10
     for sector, expected in (("in-plane", in_plane), ("out-of-plane", out_of_plane)):
-        q8, q10 = (circle.critical_q(n, sector, model=model) for n in (8, 10))
+        q8, q10 = (full_linear.critical_q(n, sector, model=model) for n in (8, 10))
         assert abs(q8 - q10) < 1e-6 and abs(q10 - expected) < 1e-6
 
 
@@ -80,7 +82,7 @@ def test_thresholds_tend_to_the_local_ones_like_one_over_c():
     eps = (1e-9, 1e-12, 1e-15)
     c = np.array([-2.0 * math.log(e) for e in eps])
     for sector, local in (("in-plane", LOCAL_IN_PLANE), ("out-of-plane", LOCAL_OUT_OF_PLANE)):
-        q = np.array([circle.critical_q(8, sector, model=models.choose("nonlocal", e))
+        q = np.array([full_linear.critical_q(8, sector, model=models.choose("nonlocal", e))
                       for e in eps])
         scaled = c * (q - local)
         assert np.all(q > local) and np.all(np.diff(q) < 0)
@@ -97,7 +99,7 @@ def test_stability_command_with_the_nonlocal_model(capsys):
     out = json.loads(capsys.readouterr().out)
     model = models.choose("nonlocal", 1e-3)
     assert (out["model"], out["slenderness"]) == ("nonlocal", 1e-3)
-    assert out["q_crit_in_plane"] == circle.critical_q(8, "in-plane", model=model)
+    assert out["q_crit_in_plane"] == full_linear.critical_q(8, "in-plane", model=model)
     for argv in (["--theta0", "30"], ["--paper"]):
         assert main(["stability", "--model", "nonlocal", "--slenderness", "1e-3"] + argv) == 2
         assert len(capsys.readouterr().err.strip().splitlines()) == 1

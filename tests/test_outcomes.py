@@ -88,7 +88,7 @@ def test_the_same_outcome_fields_in_run_json_simulate_and_sweep_rows(tmp_path, c
     assert main(["sweep"] + argv + ["--quiet", "--no-early-stop", "--out",
                                     str(tmp_path / "s")]) == 0
     row = loopsim.read_results(str(tmp_path / "s")).iloc[0]
-    for key in loopsim.io.OUTCOME_FIELDS + ("n_used", "method", "theta_final_deg"):
+    for key in loopsim.storage.OUTCOME_FIELDS + ("n_used", "method", "theta_final_deg"):
         assert printed[key] == summary[key] == row[key], key
     assert summary["regime"] == "stable" and summary["resolved"] and summary["determined"]
     assert summary["twin_nfev"] > 0 and summary["method"] == "radau5"

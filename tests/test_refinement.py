@@ -65,7 +65,7 @@ def test_spectral_tail_is_relative_to_the_deformation():
     """The tail is the top modes' share of the deformation (modes k >= 2), floored at
     DEFORMATION_FLOOR of the loop's size: the same top modes weigh more on a less
     deformed loop, and an exact circle has none."""
-    from loopsim.config import DEFORMATION_FLOOR
+    from loopsim.defaults import DEFORMATION_FLOOR
 
     circle = shapes.inclined_circle(6, 0.3)  # E_1 = 1
     assert diagnostics.spectral_tail(circle, 6) == 0.0
@@ -243,8 +243,8 @@ def test_integrations_run_with_one_blas_thread(monkeypatch):
 
     monkeypatch.setattr(refinement.integrators, "integrate",
                         recording(refinement.integrators.integrate))
-    monkeypatch.setattr(refinement.batch, "integrate_cases",
-                        recording(refinement.batch.integrate_cases))
+    monkeypatch.setattr(refinement.batch, "integrate_batch",
+                        recording(refinement.batch.integrate_batch))
     x0 = shapes.start_shape(30.0, 4, 1e-3, 0)[0]
     with threadpool_limits(limits=2, user_api="blas"):
         before = blas_threads()

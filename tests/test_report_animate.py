@@ -14,7 +14,7 @@ import pytest
 matplotlib.use("Agg")
 
 import loopsim  # noqa: E402
-from loopsim import summary, sweeps  # noqa: E402
+from loopsim import outcome_statistics, sweeps  # noqa: E402
 from loopsim.cli import main  # noqa: E402
 
 PIL = pytest.importorskip("PIL")
@@ -98,8 +98,8 @@ def test_report_parses_its_images_decode_and_its_numbers_are_the_summarys(sweep,
     assert "<script" not in content and "http://" not in content and "https://" not in content
     assert len(page.images) == 1
     png_ok(page.images[0])
-    # the per-cell table is summary.summarize's, to the 4 digits shown
-    cells = summary.summarize(frame)
+    # the per-cell table is outcome_statistics.summarize's, to the 4 digits shown
+    cells = outcome_statistics.summarize(frame)
     rows = page.tables["cells"]
     header, body = rows[0], rows[1:]
     assert len(body) == len(cells) == 4
@@ -138,7 +138,7 @@ def test_steady_is_unknown_for_a_sweep_without_early_stop(sweep, tmp_path, capsy
     (printed and written) and the report."""
     out, frame = sweep
     assert frame.attrs["loopsim"]["sweep_config"]["early_stop"] is False
-    cells = summary.summarize(frame)
+    cells = outcome_statistics.summarize(frame)
     assert cells["steady"].isna().all() and cells["seeds"].notna().all()
     table = tmp_path / "cells.parquet"
     assert main(["summary", out, "--out", str(table)]) == 0
@@ -156,13 +156,13 @@ def test_steady_is_unknown_for_a_sweep_without_early_stop(sweep, tmp_path, capsy
 
 
 def test_report_of_a_seeds_auto_directory_shows_the_distributions(tmp_path):
-    from loopsim import seeding
+    from loopsim import seeds_auto_rule
     from loopsim.sweeps.seeds_auto import run_seeds_auto
 
     config = sweeps.SweepConfig(cases=sweeps.grid_cases([10.0], [30.0], [4], 1), t_end=0.3,
                                 method="rkf45", twin=False, chunk_size=2)
     out = str(tmp_path / "auto")
-    rows, stops = run_seeds_auto(config, out, seeding.SeedTargets(),
+    rows, stops = run_seeds_auto(config, out, seeds_auto_rule.SeedTargets(),
                                  run_round=lambda c, d, weights=None: sweeps.run_sweep(
                                      c, d, threads=1, quiet=True))
     target = tmp_path / "auto.html"

@@ -9,8 +9,8 @@ import pyarrow.parquet as pq
 import pytest
 
 import loopsim
-from loopsim import columns, io, seeding, summary, sweeps
-from loopsim.io import STOPS_FILE, read_seeds_auto
+from loopsim import columns, outcome_statistics, seeds_auto_rule, storage, sweeps
+from loopsim.storage import STOPS_FILE, read_seeds_auto
 from loopsim.sweeps.seeds_auto import run_seeds_auto
 
 FAST = dict(t_end=0.3, method="rkf45", twin=False, chunk_size=2)
@@ -33,10 +33,10 @@ def runner(calls):
 def test_a_stable_cell_stops_after_the_first_round_with_a_fixed_sweeps_rows(tmp_path):
     config = sweeps.SweepConfig(cases=cells([10.0], [30.0]), **FAST)
     calls = []
-    rows, stops = run_seeds_auto(config, str(tmp_path / "auto"), seeding.SeedTargets(),
+    rows, stops = run_seeds_auto(config, str(tmp_path / "auto"), seeds_auto_rule.SeedTargets(),
                                  run_round=runner(calls))
     assert calls == [4]
-    assert stops["stop_reason"].tolist() == [seeding.DETERMINISTIC]
+    assert stops["stop_reason"].tolist() == [seeds_auto_rule.DETERMINISTIC]
     assert stops["seeds"].tolist() == [4] and stops["rounds"].tolist() == [1]
     fixed = sweeps.run_sweep(dataclasses.replace(config, cases=sweeps.grid_cases(
         [10.0], [30.0], [4], 4)), str(tmp_path / "fixed"), threads=1, quiet=True)
@@ -47,14 +47,14 @@ def test_a_stable_cell_stops_after_the_first_round_with_a_fixed_sweeps_rows(tmp_
 
 def test_rounds_double_to_the_cap_and_resume_bit_for_bit(tmp_path):
     # a tilt tolerance below the seeds' spread: never deterministic; cap 8 from 2
-    targets = seeding.SeedTargets(min_seeds=2, max_seeds=8, tilt_tol_deg=1e-12,
+    targets = seeds_auto_rule.SeedTargets(min_seeds=2, max_seeds=8, tilt_tol_deg=1e-12,
                                   p_halfwidth=0.01)
     config = sweeps.SweepConfig(cases=cells([10.0, 60.0], [30.0]), **FAST)
     calls = []
     whole, stops = run_seeds_auto(config, str(tmp_path / "whole"), targets,
                                   run_round=runner(calls))
     assert calls == [4, 4, 8]  # 2 cells x 2, then x 2 more, then x 4 more
-    assert stops["stop_reason"].tolist() == [seeding.CAP] * 2
+    assert stops["stop_reason"].tolist() == [seeds_auto_rule.CAP] * 2
     assert stops["seeds"].tolist() == [8, 8] and stops["rounds"].tolist() == [3, 3]
     assert whole["round"].tolist() == [0] * 4 + [1] * 4 + [2] * 8
     assert sorted(whole.loc[whole["g0"] == 10.0, "seed"]) == list(range(8))
@@ -79,12 +79,12 @@ def test_rounds_double_to_the_cap_and_resume_bit_for_bit(tmp_path):
 def test_other_targets_in_the_same_directory_are_refused(tmp_path):
     config = sweeps.SweepConfig(cases=cells([10.0], [30.0]), **FAST)
     out = str(tmp_path / "auto")
-    run_seeds_auto(config, out, seeding.SeedTargets(), run_round=runner([]))
+    run_seeds_auto(config, out, seeds_auto_rule.SeedTargets(), run_round=runner([]))
     with pytest.raises(ValueError, match="tilt_halfwidth_deg"):
-        run_seeds_auto(config, out, seeding.SeedTargets(tilt_halfwidth_deg=1.0),
+        run_seeds_auto(config, out, seeds_auto_rule.SeedTargets(tilt_halfwidth_deg=1.0),
                        run_round=runner([]))
     with pytest.raises(ValueError, match="t_end"):
-        run_seeds_auto(dataclasses.replace(config, t_end=0.2), out, seeding.SeedTargets(),
+        run_seeds_auto(dataclasses.replace(config, t_end=0.2), out, seeds_auto_rule.SeedTargets(),
                        run_round=runner([]))
     assert len(loopsim.read_results(out)) == 4
 
@@ -94,9 +94,9 @@ def test_the_python_sweep_runs_seeds_auto_and_refuses_targets_without_it(tmp_pat
     rows = loopsim.sweep([10.0], [30.0], out, n=4, seeds="auto", max_seeds=8, threads=1,
                          **FAST)
     assert len(rows) == 4 and rows["round"].tolist() == [0] * 4
-    stops = io.read_stop_table(str(out))
-    assert stops["stop_reason"].tolist() == [seeding.DETERMINISTIC]
-    schema = pq.read_schema(out / io.STOPS_FILE)
+    stops = storage.read_stop_table(str(out))
+    assert stops["stop_reason"].tolist() == [seeds_auto_rule.DETERMINISTIC]
+    schema = pq.read_schema(out / storage.STOPS_FILE)
     assert schema.field("n").type == pa.int64() and stops["n"].tolist() == [4]
     assert all(f.metadata[b"unit"] == columns.STOP_COLUMNS[f.name][0].encode() for f in schema)
     with pytest.raises(ValueError, match="seeds='auto'"):
@@ -106,12 +106,12 @@ def test_the_python_sweep_runs_seeds_auto_and_refuses_targets_without_it(tmp_pat
 
 
 def test_every_target_is_an_option_of_the_command_line_and_of_sweep(tmp_path):
-    """Each of config.SEED_TARGETS reaches seeding.SeedTargets from --OPTION and from
+    """Each of config.SEED_TARGETS reaches seeds_auto_rule.SeedTargets from --OPTION and from
     sweep(OPTION=): a target given both ways is stored in the directory's record."""
     import json
 
     from loopsim.cli import main
-    from loopsim.config import SEED_TARGETS
+    from loopsim.defaults import SEED_TARGETS
 
     given = dict(p_halfwidth=0.3, tilt_halfwidth=7.5, min_seeds=2, max_seeds=2)
     for how in ("cli", "python"):
@@ -123,7 +123,7 @@ def test_every_target_is_an_option_of_the_command_line_and_of_sweep(tmp_path):
                          "--out", str(out), *flags]) == 0
         else:
             loopsim.sweep([10.0], [30.0], out, n=4, seeds="auto", threads=1, **given, **FAST)
-        stored = json.loads((out / io.SEEDS_FILE).read_text())["targets"]
+        stored = json.loads((out / storage.SEEDS_FILE).read_text())["targets"]
         assert {SEED_TARGETS[k][0]: stored[SEED_TARGETS[k][0]] for k in given} == {
             SEED_TARGETS[k][0]: v for k, v in given.items()}, how
 
@@ -134,11 +134,11 @@ def test_seeds_auto_from_the_command_line(tmp_path, capsys):
     out = tmp_path / "auto"
     args = ["sweep", "--g0", "10", "--theta0", "30", "--n", "4", "--t-end", "0.3",
             "--no-twin", "--seeds", "auto", "--max-seeds", "8", "--threads", "1", "--quiet",
-            "--out", str(out), "--figure", str(tmp_path / "summary.png")]
+            "--out", str(out), "--figure", str(tmp_path / "outcome_statistics.png")]
     assert main(args) == 0
     printed = capsys.readouterr().out
     assert "1 points, seeds until sharp: deterministic 1" in printed
-    assert (tmp_path / "summary.png").stat().st_size > 0
+    assert (tmp_path / "outcome_statistics.png").stat().st_size > 0
     assert main(args) == 0  # resumed: nothing to do, the same table
     assert len(loopsim.read_results(str(out))) == 4
     for bad, message in ((["--min-seeds", "4"], "--min-seeds applies only with --seeds auto"),
@@ -167,10 +167,10 @@ def _rows(regimes, determined, round_=0):
 
 
 def test_runs_are_samples_when_seeds_disagree_or_a_twin_does():
-    assert not seeding.runs_are_samples(_rows(["3d"] * 4, [True] * 4))
-    assert seeding.runs_are_samples(_rows(["3d", "in-plane", "3d", "3d"], [True] * 4))
-    assert seeding.runs_are_samples(_rows(["3d"] * 4, [True, False, True, True]))
-    assert not seeding.runs_are_samples(_rows(["3d"] * 4, [None] * 4))  # no twins: no sign
+    assert not seeds_auto_rule.runs_are_samples(_rows(["3d"] * 4, [True] * 4))
+    assert seeds_auto_rule.runs_are_samples(_rows(["3d", "in-plane", "3d", "3d"], [True] * 4))
+    assert seeds_auto_rule.runs_are_samples(_rows(["3d"] * 4, [True, False, True, True]))
+    assert not seeds_auto_rule.runs_are_samples(_rows(["3d"] * 4, [None] * 4))  # no twins: no sign
 
 
 def test_sampled_cells_drop_their_twins_and_are_checked_in_distribution():
@@ -180,7 +180,7 @@ def test_sampled_cells_drop_their_twins_and_are_checked_in_distribution():
     cells' rows (twins counted where they run)."""
     from loopsim.sweeps import seeds_auto
 
-    targets = seeding.SeedTargets(check_seeds=3)
+    targets = seeds_auto_rule.SeedTargets(check_seeds=3)
     cell = dict(g0=150.0, theta0_deg=60.0, n=6, perturbation=0.01, seed=0)
     first = _rows(["3d", "3d", "in-plane", "3d"], [True, False, True, True])
     cases = seeds_auto.plan_round([cell], first, targets)
@@ -216,7 +216,7 @@ def test_sampled_cells_drop_their_twins_and_are_checked_in_distribution():
                                   checks=checks)
     sampled, settled = table.iloc[0], table.iloc[1]
     assert (sampled["runs"], sampled["twins"], sampled["check_seeds"]) == ("samples", 4, 7)
-    assert sampled["check_verdict"] in (summary.SAME, summary.DIFFERENT)
+    assert sampled["check_verdict"] in (outcome_statistics.SAME, outcome_statistics.DIFFERENT)
     assert 0 <= sampled["check_tilt_ks_p"] <= 1 and sampled["check_tilt_wasserstein"] > 0
     assert (settled["runs"], settled["twins"], settled["check_seeds"]) == ("trajectories", 4, 0)
     assert settled["check_verdict"] == "" and np.isnan(settled["check_tilt_ks_p"])
@@ -229,16 +229,16 @@ def test_a_cell_whose_every_seed_fails_stops_as_failed_without_a_check(tmp_path)
     failures.  It stops after its first round, twins kept, with no check and no verdict."""
     config = sweeps.SweepConfig(cases=cells([60.0], [30.0]), t_end=0.2, method="rkf45",
                                 twin=True, chunk_size=2, max_steps=3)
-    targets = seeding.SeedTargets(max_seeds=8)
+    targets = seeds_auto_rule.SeedTargets(max_seeds=8)
     calls = []
     out = tmp_path / "auto"
     rows, stops = run_seeds_auto(config, str(out), targets, run_round=runner(calls))
     assert calls == [4] and set(rows["regime"]) == {"failed"}
     assert rows["twin_nfev"].gt(0).all()  # every seed kept its twin
     stop = stops.iloc[0]
-    assert (stop["stop_reason"], stop["seeds"], stop["runs"]) == (seeding.FAILED, 4, "none")
+    assert (stop["stop_reason"], stop["seeds"], stop["runs"]) == (seeds_auto_rule.FAILED, 4, "none")
     assert (stop["check_seeds"], stop["check_verdict"]) == (0, "")
-    assert not (out / io.CHECK_DIR).exists()
+    assert not (out / storage.CHECK_DIR).exists()
 
 
 def test_check_seeds_0_says_the_later_seeds_ran_with_twins(tmp_path, capsys, monkeypatch):
@@ -265,7 +265,7 @@ def test_check_seeds_0_says_the_later_seeds_ran_with_twins(tmp_path, capsys, mon
     printed = capsys.readouterr().out
     rows = loopsim.read_results(str(out))
     assert len(rows) == 4 and rows["twin_nfev"].gt(0).all()  # the later seeds had twins
-    assert io.read_stop_table(str(out))["runs"].tolist() == ["samples"]
+    assert storage.read_stop_table(str(out))["runs"].tolist() == ["samples"]
     line = next(line for line in printed.splitlines() if "runs are samples" in line)
     assert "ran with twins" in line and "without twins" not in line, line
     assert "not checked (--check-seeds 0)" in line, line
@@ -283,13 +283,13 @@ def test_a_sampled_cell_end_to_end(tmp_path):
                                 twin=True, chunk_size=2,
                                 thresholds=Thresholds(determined_tilt_deg=1e-15,
                                                       determined_aspect=1e-15))
-    targets = seeding.SeedTargets(min_seeds=2, max_seeds=4, tilt_tol_deg=1e-12,
+    targets = seeds_auto_rule.SeedTargets(min_seeds=2, max_seeds=4, tilt_tol_deg=1e-12,
                                   p_halfwidth=0.01, check_seeds=4)
     out = tmp_path / "auto"
     rows, stops = run_seeds_auto(config, str(out), targets, run_round=runner([]))
     assert rows["twin_nfev"].gt(0).tolist() == [True, True, False, False]
     assert rows["determined"].tolist()[:2] == [False, False]
-    check = loopsim.read_results(str(out / io.CHECK_DIR))
+    check = loopsim.read_results(str(out / storage.CHECK_DIR))
     assert list(check["seed"]) == [2, 3] and set(check["rtol"]) == {config.rtol / 10}
     throughout = sweeps.run_sweep(dataclasses.replace(config, cases=sweeps.grid_cases(
         [60.0], [30.0], [4], 4)), str(tmp_path / "twins"), threads=1, quiet=True)
@@ -297,5 +297,5 @@ def test_a_sampled_cell_end_to_end(tmp_path):
     assert list(check["theta_final_deg"]) == list(throughout["twin_theta_final_deg"][2:])
     stop = stops.iloc[0]
     assert (stop["runs"], stop["twins"], stop["check_seeds"]) == ("samples", 2, 4)
-    assert stop["check_verdict"] == summary.SAME  # 10x stricter: the same tilts to 1e-5
-    pd.testing.assert_frame_equal(io.read_stop_table(str(out)), stops)
+    assert stop["check_verdict"] == outcome_statistics.SAME  # 10x stricter: the same tilts to 1e-5
+    pd.testing.assert_frame_equal(storage.read_stop_table(str(out)), stops)

@@ -9,7 +9,7 @@ import shutil
 import pytest
 
 import loopsim
-from loopsim import io, seeding, sweeps
+from loopsim import seeds_auto_rule, storage, sweeps
 from loopsim.cli import main
 from loopsim.sweeps.seeds_auto import run_seeds_auto
 
@@ -72,7 +72,7 @@ def test_max_seeds_bounded_by_the_largest_total_before_any_work(tmp_path):
     config = sweeps.SweepConfig(cases=sweeps.grid_cases([10.0, 20.0], [30.0], [4], 1),
                                 t_end=0.3, twin=False)
     with pytest.raises(ValueError, match="2 points x --max-seeds 600000 = 1200000 cases"):
-        run_seeds_auto(config, str(tmp_path / "a"), seeding.SeedTargets(max_seeds=600_000),
+        run_seeds_auto(config, str(tmp_path / "a"), seeds_auto_rule.SeedTargets(max_seeds=600_000),
                        run_round=lambda *_: pytest.fail("ran a round"))
     assert not (tmp_path / "a").exists()
 
@@ -82,7 +82,7 @@ def test_a_fixed_seed_sweep_is_refused_in_a_seeds_auto_directory(auto, capsys):
     before = listing(auto)
     assert main(["sweep", *GRID, "--out", auto]) == 2
     assert "holds a --seeds auto sweep" in capsys.readouterr().err
-    round_zero = io.round_directory(auto, 0)
+    round_zero = storage.round_directory(auto, 0)
     assert main(["sweep", "--g0", "10,20", "--theta0", "30", "--n", "4", "--t-end", "0.2",
                  "--quiet", "--out", round_zero]) == 2
     assert "is round 0 of the --seeds auto sweep" in capsys.readouterr().err
@@ -94,16 +94,16 @@ def test_a_round_copied_in_from_another_sweep_is_refused_on_read(auto, tmp_path,
     """Issue 36.9: a round of a sweep with another perturbation put in place of round 0."""
     other = str(tmp_path / "other")
     assert main(["sweep", *AUTO, "--perturbation", "0.02", "--out", other]) == 0
-    shutil.rmtree(io.round_directory(auto, 0))
-    shutil.copytree(io.round_directory(other, 0), io.round_directory(auto, 0))
+    shutil.rmtree(storage.round_directory(auto, 0))
+    shutil.copytree(storage.round_directory(other, 0), storage.round_directory(auto, 0))
     with pytest.raises(ValueError, match="is not a round of the --seeds auto sweep"):
         loopsim.read_results(auto)
     assert main(["summary", auto]) == 2
     assert "round-00" in capsys.readouterr().err
     # a directory recorded before round fingerprints were: its options are compared
-    record = io.read_seeds_file(auto)
+    record = storage.read_seeds_file(auto)
     del record["rounds"]
-    io.write_json_atomically(record, os.path.join(auto, io.SEEDS_FILE))
+    storage.write_json_atomically(record, os.path.join(auto, storage.SEEDS_FILE))
     with pytest.raises(ValueError, match="is not a round of the --seeds auto sweep"):
         loopsim.read_results(auto)
 
@@ -112,7 +112,7 @@ def test_a_resume_may_change_the_chunk_size(tmp_path):
     """Issue 36.8: as with fixed seeds, the chunk size is no part of the sweep."""
     config = sweeps.SweepConfig(cases=sweeps.grid_cases([10.0, 60.0], [30.0], [4], 1),
                                 t_end=0.3, method="rkf45", twin=False, chunk_size=2)
-    targets = seeding.SeedTargets(min_seeds=2, max_seeds=4, tilt_tol_deg=1e-12,
+    targets = seeds_auto_rule.SeedTargets(min_seeds=2, max_seeds=4, tilt_tol_deg=1e-12,
                                   p_halfwidth=0.01)
     calls = []
 
@@ -140,7 +140,7 @@ def test_failed_cases_of_a_seeds_auto_directory_are_rerun(tmp_path, capsys):
     out = str(tmp_path / "a")
     config = sweeps.SweepConfig(cases=sweeps.grid_cases([10.0], [30.0], [4], 1), t_end=3.0,
                                 max_steps=150, method="rkf45", twin=False)
-    rows, stops = run_seeds_auto(config, out, seeding.SeedTargets(min_seeds=2, max_seeds=2),
+    rows, stops = run_seeds_auto(config, out, seeds_auto_rule.SeedTargets(min_seeds=2, max_seeds=2),
                                  run_round=lambda c, d, w: sweeps.run_sweep(c, d, threads=1,
                                                                          quiet=True))
     assert list(rows["status"]) == ["step budget exhausted"] * 2
@@ -150,11 +150,11 @@ def test_failed_cases_of_a_seeds_auto_directory_are_rerun(tmp_path, capsys):
     again = loopsim.read_results(out)
     assert list(again["status"]) == ["ok", "ok"] and list(again["seed"]) == [0, 1]
     assert list(again["method"]) == ["radau5"] * 2
-    assert io.read_stop_table(out).equals(stops)  # why each cell stopped, as written
+    assert storage.read_stop_table(out).equals(stops)  # why each cell stopped, as written
     assert main(["sweep", "--rerun-failed", out, "--method", "radau5", "--quiet"]) == 0
     assert "reran 0 failed" in capsys.readouterr().out
     unfinished = str(tmp_path / "b")
     shutil.copytree(out, unfinished)
-    os.remove(os.path.join(unfinished, io.STOPS_FILE))
+    os.remove(os.path.join(unfinished, storage.STOPS_FILE))
     assert main(["sweep", "--rerun-failed", unfinished, "--rtol", "1e-5"]) == 2
     assert "has not finished" in capsys.readouterr().err

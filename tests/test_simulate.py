@@ -8,7 +8,7 @@ import pyarrow.parquet as pq
 import pytest
 
 import loopsim
-from loopsim import api, diagnostics as D, io, shapes
+from loopsim import api, diagnostics as D, storage, shapes
 from loopsim.cli import main
 
 
@@ -101,7 +101,7 @@ def test_cli_run_json_and_parquet(tmp_path, capsys):
     assert summary.pop("compile_s") >= 0.0  # kernel compilation, not in wall_s
     table = pq.read_table(out)
     assert table.num_rows == 3 and table.column("x").type.list_size == 3 * 13
-    meta = io.read_metadata(out)
+    meta = storage.read_metadata(out)
     assert meta["summary"] == summary and meta["loopsim_version"] == loopsim.__version__
     assert [p.name for p in tmp_path.iterdir()] == ["run.parquet"]  # no temporary left
 

@@ -15,10 +15,10 @@ import pyarrow.parquet as pq
 import pytest
 
 import loopsim
-from loopsim import io, sweeps
+from loopsim import storage, sweeps
 from loopsim.cli import main
 
-DETERMINISTIC = [c for c in io.RESULT_SCHEMA.names if c != "wall_s"]
+DETERMINISTIC = [c for c in storage.RESULT_SCHEMA.names if c != "wall_s"]
 
 
 def config(**kwargs):
@@ -45,7 +45,7 @@ def same_rows(a, b):
 def test_dataset_readers_return_exactly_the_rows(reference):
     out, frame = reference
     assert sorted(os.listdir(out)) == ["_snapshots", "_sweep.json"] + sorted(
-        io.CHUNK_PATTERN.format(s, e) for s, e in [(0, 2), (2, 4), (4, 6)])
+        storage.CHUNK_PATTERN.format(s, e) for s, e in [(0, 2), (2, 4), (4, 6)])
     by_id = lambda f: f.sort_values("case_id").reset_index(drop=True)  # noqa: E731
     same_rows(by_id(pd.read_parquet(out)), frame)
     same_rows(by_id(ds.dataset(out).to_table().to_pandas()), frame)
@@ -62,15 +62,15 @@ def test_configuration_stored_once_fingerprint_in_each_file(reference):
     with open(os.path.join(out, "_sweep.json")) as handle:
         stored = json.load(handle)
     assert stored["config"]["t_end"] == 0.3 and len(stored["config"]["cases"]) == 6
-    for (start, stop), path in io.chunk_files(out).items():
-        meta = io.read_metadata(path)
+    for (start, stop), path in storage.chunk_files(out).items():
+        meta = storage.read_metadata(path)
         assert "sweep_config" not in meta and "command_line" not in meta
-        assert meta["sweep_fingerprint"] == stored["fingerprint"] == io.config_fingerprint(
+        assert meta["sweep_fingerprint"] == stored["fingerprint"] == storage.config_fingerprint(
             stored["config"])
         assert meta["positions"] == [start, stop]
     assert frame.attrs["loopsim"]["sweep_config"]["t_end"] == 0.3
-    assert io.config_fingerprint(dict(stored["config"], chunk_size=7)) == stored["fingerprint"]
-    assert io.config_fingerprint(dict(stored["config"], t_end=0.4)) != stored["fingerprint"]
+    assert storage.config_fingerprint(dict(stored["config"], chunk_size=7)) == stored["fingerprint"]
+    assert storage.config_fingerprint(dict(stored["config"], t_end=0.4)) != stored["fingerprint"]
 
 
 def test_the_tables_metadata_describes_the_whole_table(reference):
@@ -78,15 +78,15 @@ def test_the_tables_metadata_describes_the_whole_table(reference):
     times, never one file's positions, content hash or creation time."""
     out, frame = reference
     meta = frame.attrs["loopsim"]
-    files = [io.read_metadata(path) for path in io.chunk_files(out).values()]
+    files = [storage.read_metadata(path) for path in storage.chunk_files(out).values()]
     assert meta["files"] == len(files) == 3
-    assert not {"positions", io.CONTENT_KEY, "created_utc"} & set(meta)
+    assert not {"positions", storage.CONTENT_KEY, "created_utc"} & set(meta)
     created = sorted(m["created_utc"] for m in files)
     assert (meta["created_utc_first"], meta["created_utc_last"]) == (created[0], created[-1])
     assert meta["sweep_fingerprint"] == files[0]["sweep_fingerprint"]
     assert meta["loopsim_version"] == loopsim.__version__
     # a value the files disagree on is listed, not taken from the first file
-    mixed = io.table_metadata([dict(files[0], loopsim_version="0.1"), files[1]])
+    mixed = storage.table_metadata([dict(files[0], loopsim_version="0.1"), files[1]])
     assert mixed["loopsim_version"] == sorted(["0.1", files[1]["loopsim_version"]])
 
 
@@ -126,9 +126,9 @@ def test_changed_chunk_size_resumes_without_loss_or_duplicates(tmp_path, referen
     out = str(tmp_path / "s")
     traced = dict(snapshots_for=[4], snapshot_count=3)  # as the reference
     sweeps.run_sweep(config(chunk_size=2, **traced), out, quiet=True, shard=(0, 2))  # chunks 0, 2
-    assert sorted(io.chunk_files(out)) == [(0, 2), (4, 6)]
+    assert sorted(storage.chunk_files(out)) == [(0, 2), (4, 6)]
     frame = sweeps.run_sweep(config(chunk_size=3, **traced), out, quiet=True)  # [0, 3), [3, 6)
-    assert sorted(io.chunk_files(out)) == [(0, 2), (2, 3), (3, 4), (4, 6)]
+    assert sorted(storage.chunk_files(out)) == [(0, 2), (2, 3), (3, 4), (4, 6)]
     same_rows(frame, reference[1])
 
 
@@ -261,10 +261,10 @@ def test_resume_after_sigint_equals_uninterrupted_run(tmp_path):
     process.send_signal(signal.SIGINT)
     rest = process.communicate(timeout=60)[1]
     assert process.returncode == 130, rest
-    (piece,) = io.chunk_files(str(out))  # one chunk of 9, cut short
+    (piece,) = storage.chunk_files(str(out))  # one chunk of 9, cut short
     assert piece[0] == 0 and 2 <= piece[1] < 9
     assert main(args + ["--quiet", "--out", str(out)]) == 0
-    assert sorted(io.chunk_files(str(out))) == [piece, (piece[1], 9)]
+    assert sorted(storage.chunk_files(str(out))) == [piece, (piece[1], 9)]
     same_rows(loopsim.read_results(str(out)), loopsim.read_results(str(reference)))
 
 
@@ -342,9 +342,9 @@ def test_stop_writes_finished_cases_past_a_running_one(tmp_path, reference, monk
         sweeps.run_sweep(config(snapshots_for=[4], snapshot_count=3), out, threads=2,
                          quiet=True)
     release.set()  # the held worker goes on unseen, as a kernel would after a signal
-    assert sorted(io.chunk_files(out)) == [(1, 2), (2, 4), (4, 6)]
+    assert sorted(storage.chunk_files(out)) == [(1, 2), (2, 4), (4, 6)]
     frame = _resume_computes(monkeypatch, out, [0])
-    assert sorted(io.chunk_files(out)) == [(0, 1), (1, 2), (2, 4), (4, 6)]
+    assert sorted(storage.chunk_files(out)) == [(0, 1), (1, 2), (2, 4), (4, 6)]
     same_rows(frame, reference[1])
     assert len(loopsim.read_snapshots(out)) == 3
 
@@ -366,7 +366,7 @@ def test_worker_error_is_raised_after_finished_cases_are_written(tmp_path, refer
     with pytest.raises(RuntimeError, match="position 3"):
         sweeps.run_sweep(config(snapshots_for=[4], snapshot_count=3), out, threads=2,
                          quiet=True)
-    written = [p for low, high in io.chunk_files(out) for p in range(low, high)]
+    written = [p for low, high in storage.chunk_files(out) for p in range(low, high)]
     assert 3 not in written and len(set(written)) == len(written)
     frame = _resume_computes(monkeypatch, out, sorted(set(range(6)) - set(written)))
     same_rows(frame, reference[1])

@@ -19,7 +19,7 @@ import textwrap
 import warnings
 
 from .._version import __version__
-from ..config import ENVIRONMENT_ERRNOS
+from ..exit_codes import ENVIRONMENT_ERRNOS
 from . import animate, branch, compare, figures, report, run, stability, summary, sweep
 from .common import EXIT_ENVIRONMENT, EXIT_EPILOG, EXIT_FAILED_RUN, EXIT_USAGE, METHODS, Parser
 

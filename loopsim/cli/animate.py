@@ -4,7 +4,7 @@ from .common import HelpFormatter, use_agg
 
 def add_parser(commands):
     """The ``animate`` command and its options."""
-    from ..outputs import (
+    from ..render_defaults import (
         ANIMATION_DPI as DPI, ANIMATION_DPI_RANGE, ANIMATION_FPS as FPS, ANIMATION_FRAMES as FRAMES,
         ANIMATION_MAX_FPS as MAX_FPS, ANIMATION_MAX_FRAMES as MAX_FRAMES,
     )

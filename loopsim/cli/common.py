@@ -1,12 +1,11 @@
 """What the commands share: exit statuses, the parser's classes and argument types,
 the integration options, and the ways a command prints, draws and ends."""
 import argparse
-import functools
 import math
 import os
 import sys
 
-from ..config import (
+from ..defaults import (
     DEFAULT_ATOL, DEFAULT_N, DEFAULT_N_MAX, DEFAULT_PERTURBATION, DEFAULT_RTOL, DEFAULT_T_END,
     DEFAULT_TAIL_TOL, DEFAULT_W, MAX_SLENDERNESS, MODEL_CHOICES,
 )
@@ -170,15 +169,15 @@ def print_and_write(table, out, meta, shown=None, *, declarations):
     import pandas as pd
     import pyarrow as pa
 
-    from .. import io
+    from .. import storage
 
     with pd.option_context("display.width", 160, "display.max_columns", 40):
         print(table[shown or list(table.columns)].to_string(
             index=False, float_format=lambda v: f"{v:.4g}"))
     if out is not None:
-        io.write_table_atomically(io.described(
+        storage.write_table_atomically(storage.described(
             pa.Table.from_pandas(table, preserve_index=False)
-            .replace_schema_metadata(io.provenance(**meta)), declarations), out)
+            .replace_schema_metadata(storage.provenance(**meta)), declarations), out)
         print(f"table: {out}")
 
 
@@ -193,33 +192,3 @@ def use_agg():
     import matplotlib
 
     matplotlib.use("Agg")
-
-
-#: Where the steady branch drawn under a distribution summary ends, at most (its cost
-#: grows with it: about 25 s to q = 25 at n = 12 on one core).
-BRANCH_Q_MAX = 25.0
-
-
-@functools.lru_cache(maxsize=4)
-def steady_branch_to(q_max):
-    """The local model's steady branch at n = 12 up to ``q_max`` (a DataFrame, or None),
-    computed once per process for each ``q_max``."""
-    from ..figures.linear import load_branch
-
-    return load_branch(12, q_max=q_max)[0]
-
-
-def save_distribution_figure(table, frame, path, dpi=150):
-    """Draw a summary table and its rows (``figures.distribution_summary``) to ``path``:
-    for the local model over its steady branch up to the largest terminal q seen,
-    rounded up to a multiple of 5 (at most :data:`BRANCH_Q_MAX`)."""
-    from .. import figures
-
-    use_agg()
-    branch = None
-    q_final = frame["q_final"].to_numpy(float) if "q_final" in frame else []
-    q_seen = [float(q) for q in q_final if q == q]
-    if figures.frame_model(frame).name == "local" and q_seen:
-        branch = steady_branch_to(min(BRANCH_Q_MAX, 5.0 * math.ceil(1.05 * max(q_seen) / 5.0)
-                                      or 5.0))
-    figures.save(figures.distribution_summary(table, frame, branch=branch), path, dpi=dpi)

@@ -10,7 +10,7 @@ def add_parser(commands):
         description="Per cell of two sweeps (say n = 24 and n = 32, or rtol 1e-6 and 1e-8, "
         "each with several seeds): Kolmogorov-Smirnov tests of the terminal tilt and "
         "aspect ratio, the tilt's Wasserstein distance with a bootstrap interval, a "
-        "chi-square test of the regime counts, and a verdict (loopsim/summary.py).",
+        "chi-square test of the regime counts, and a verdict (loopsim/outcome_statistics.py).",
         formatter_class=HelpFormatter,
     )
     compare.add_argument("sweep_a", metavar="SWEEP_A", help="a sweep directory")
@@ -25,14 +25,15 @@ def add_parser(commands):
 
 
 def command(args):
-    from .. import columns, io, summary, validation
+    from .. import columns, outcome_statistics, storage, validation
 
     validation.check_integer("--seed", args.seed, 0)
     validation.check_real("--alpha", args.alpha, low=0.0, high=1.0, low_open=True)
     if args.out is not None:
         validation.check_output_file("--out", args.out)
-    table = summary.compare(io.read_results(args.sweep_a), io.read_results(args.sweep_b),
-                            alpha=args.alpha, seed=args.seed)
+    table = outcome_statistics.compare(storage.read_results(args.sweep_a),
+                                       storage.read_results(args.sweep_b),
+                                       alpha=args.alpha, seed=args.seed)
     print_and_write(table, args.out, dict(table.attrs["loopsim_compare"], compared=[
         directory_name(args.sweep_a), directory_name(args.sweep_b)]),
                     declarations=columns.COMPARE_COLUMNS)

@@ -4,7 +4,7 @@ from .common import HelpFormatter, use_agg
 
 def add_parser(commands):
     """The ``report`` command and its options."""
-    from ..outputs import REPORT_COSTLIEST
+    from ..render_defaults import REPORT_COSTLIEST
 
     report = commands.add_parser(
         "report", help="one self-contained HTML page of a sweep: provenance, counts, "

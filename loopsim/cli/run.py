@@ -4,7 +4,7 @@ import argparse
 import json
 import sys
 
-from ..config import DEFAULT_N, DEFAULT_SEED
+from ..defaults import DEFAULT_N, DEFAULT_SEED
 from .common import (
     EXIT_FAILED_RUN, HelpFormatter, add_integration_options, check_auto_options, interrupted,
     real,
@@ -120,7 +120,7 @@ def command(args):
 def _run(args):
     import functools
 
-    from .. import api, io, sweeps, validation
+    from .. import api, storage, sweeps, validation
 
     _check_run_sizes(args)
     if args.out is not None:
@@ -150,12 +150,12 @@ def _run(args):
             info = dict(info, perturbation=summary["perturbation"])
             result.initial_info = info
         if args.out:  # a signal now waits for the (atomic) write to finish
-            table = io.trajectory_table(result, command_line=sys.argv)
+            table = storage.trajectory_table(result, command_line=sys.argv)
             if info is not None:  # the initial shape's diagnostics (scale, source)
                 meta = dict(table.schema.metadata or {})
                 meta[b"initial"] = json.dumps(info).encode()
                 table = table.replace_schema_metadata(meta)
-            io.write_table_atomically(table, args.out)
+            storage.write_table_atomically(table, args.out)
     summary["compile_s"] = result.compile_s
     if args.json:
         print(json.dumps(summary if info is None else dict(summary, initial=info)))

@@ -3,7 +3,7 @@ linearisation, or the paper's operator (``--paper``)."""
 import json
 import math
 
-from ..config import DEFAULT_W
+from ..defaults import DEFAULT_W
 from .common import HelpFormatter, add_model_options, real, use_agg
 
 
@@ -53,8 +53,26 @@ FULL_ONLY = ("n", "theta0", "w", "q_scan", "g0", "top", "onset", "figure", "slen
 
 
 def _cmd_stability_full(args):
-    from .. import figures, models, sweeps, validation
-    from ..stability import circle, onset, paper
+    from .. import figures
+
+    model = _check_full_options(args)
+    full = dict(w=args.w, model=model)
+    out = _full_results(args, model, full)
+    if args.figure:
+        use_agg()
+        figures.save(figures.growth_rates(args.n, theta0_deg=args.theta0, **full), args.figure,
+                     dpi=120)
+        out["figure"] = args.figure
+    if args.json:
+        print(json.dumps(out))
+        return 0
+    _print_full(args, model, out)
+    return 0
+
+
+def _check_full_options(args):
+    """The full linearisation's options checked (the defaults filled in): its model."""
+    from .. import models, validation
 
     if args.figure is not None:
         validation.check_output_file("--figure", args.figure)
@@ -76,28 +94,40 @@ def _cmd_stability_full(args):
         raise ValueError(f"--theta0 {args.theta0:g}: with --model nonlocal the in-plane and "
                          "out-of-plane sectors decouple only at --theta0 90 (the normal "
                          "gravity couples them through the nonlocal operator; docs/nonlocal.md)")
-    full = dict(w=args.w, model=model)
-    nan_none = lambda v: None if math.isnan(v) else v  # noqa: E731
+    return model
+
+
+def _nan_none(value):
+    return None if math.isnan(value) else value
+
+
+def _full_results(args, model, full):
+    """The JSON object of ``loopsim stability`` (full): critical q of each operator, and
+    the q scan, the spectrum at --g0 and the onset q when asked for."""
+    from .. import sweeps
+    from ..stability import full_linear, onset, paper
+
     out = {
         "operator": "full", "n": args.n, "theta0_deg": args.theta0, "w": args.w,
         "model": model.name, "slenderness": model.slenderness,
-        "q_crit_in_plane": nan_none(circle.critical_q(args.n, "in-plane", args.theta0, **full)),
-        "q_crit_out_of_plane": nan_none(circle.critical_q(args.n, "out-of-plane", args.theta0,
-                                                          **full)),
-        "q_crit_paper": nan_none(paper.critical_q(args.n)),
-        "q_crit_corrected_operator": nan_none(paper.critical_q(args.n, corrected=True)),
+        "q_crit_in_plane": _nan_none(full_linear.critical_q(args.n, "in-plane", args.theta0,
+                                                            **full)),
+        "q_crit_out_of_plane": _nan_none(full_linear.critical_q(args.n, "out-of-plane",
+                                                                args.theta0, **full)),
+        "q_crit_paper": _nan_none(paper.critical_q(args.n)),
+        "q_crit_corrected_operator": _nan_none(paper.critical_q(args.n, corrected=True)),
     }
     if args.q_scan:
-        out["q_scan"] = circle.paper_comparison(
+        out["q_scan"] = full_linear.paper_comparison(
             sweeps.parse_values(args.q_scan, "--q-scan"), args.n, args.theta0, **full)
     if args.g0 is not None:
         if args.g0 < 0.0:
             raise ValueError(f"--g0 must be >= 0, got {args.g0}")
-        spec = circle.full_spectrum(args.g0, args.theta0, args.n, **full)
+        spec = full_linear.full_spectrum(args.g0, args.theta0, args.n, **full)
         top = (spec.sector != "neutral").nonzero()[0][:max(1, args.top)]
         out["spectrum"] = {
             "g0": args.g0, "q": spec.q, "neutral_modes": int((spec.sector == "neutral").sum()),
-            "growth_rate": {s: spec.growth_rate(s) for s in circle.SECTORS},
+            "growth_rate": {s: spec.growth_rate(s) for s in full_linear.SECTORS},
             "eigenvalues_real": spec.eigenvalues.real[top].tolist(),
             "eigenvalues_imag": spec.eigenvalues.imag[top].tolist(),
             "sector": spec.sector[top].tolist(),
@@ -106,16 +136,16 @@ def _cmd_stability_full(args):
     if args.onset:
         eps, t_end, detect = args.onset
         out["onset"] = {"eps": eps, "t_end": t_end, "detect": detect, **{
-            f"q_{s.replace('-', '_')}": nan_none(onset.onset_q(
-                eps, t_end, detect, args.n, s, args.theta0, **full)) for s in circle.SECTORS}}
-    if args.figure:
-        use_agg()
-        figures.save(figures.growth_rates(args.n, theta0_deg=args.theta0, **full), args.figure,
-                   dpi=120)
-        out["figure"] = args.figure
-    if args.json:
-        print(json.dumps(out))
-        return 0
+            f"q_{s.replace('-', '_')}": _nan_none(onset.onset_q(
+                eps, t_end, detect, args.n, s, args.theta0, **full))
+            for s in full_linear.SECTORS}}
+    return out
+
+
+def _print_full(args, model, out):
+    """The full linearisation's results as text."""
+    from ..stability import paper
+
     print(f"# full linearisation about the translating circle, n = {args.n}, "
           f"theta0 = {args.theta0} deg, w = {args.w}, model = {model.name}"
           + (f" (slenderness {model.slenderness:g})" if model.slenderness else ""))
@@ -138,7 +168,6 @@ def _cmd_stability_full(args):
             print(f"onset {key:<16}  {value}")
     if args.figure:
         print(f"figure: {args.figure}")
-    return 0
 
 
 def command(args):

@@ -1,9 +1,7 @@
 """``loopsim summary``: one row per cell of a sweep (regime probabilities, medians, with
 intervals), printed and optionally written and drawn."""
-from ..shapes.circle import PERTURBATION_ENSEMBLE
-from .common import (
-    HelpFormatter, directory_name, print_and_write, save_distribution_figure,
-)
+from ..shapes.tilted_circle import PERTURBATION_ENSEMBLE
+from .common import HelpFormatter, directory_name, print_and_write, use_agg
 
 
 def add_parser(commands):
@@ -17,7 +15,7 @@ def add_parser(commands):
         "--no-early-stop), each regime's "
         "probability with its Wilson interval, the median and quartiles of the terminal "
         "tilt and aspect ratio with bootstrap intervals of the medians, and the cost "
-        "(loopsim/summary.py).",
+        "(loopsim/outcome_statistics.py).",
         formatter_class=HelpFormatter,
     )
     summary.add_argument("sweep_dir", metavar="SWEEP_DIR", help="a sweep directory")
@@ -31,20 +29,20 @@ def add_parser(commands):
 
 
 def command(args):
-    from .. import columns, io, summary, validation
+    from .. import columns, outcome_statistics, storage, validation
 
     validation.check_integer("--seed", args.seed, 0)
     for name, path in (("--out", args.out), ("--figure", args.figure)):
         if path is not None:
             validation.check_output_file(name, path)
-    frame = io.read_results(args.sweep_dir)
-    table = summary.summarize(frame, seed=args.seed)
+    frame = storage.read_results(args.sweep_dir)
+    table = outcome_statistics.summarize(frame, seed=args.seed)
     if args.figure is not None:  # refused before anything is written
         from .. import figures
 
         figures.frame_model(frame)
         figures.check_one_cell_per_point(table)
-    shown = [c for c in table.columns if c in summary.CELL_INPUTS] + [
+    shown = [c for c in table.columns if c in outcome_statistics.CELL_INPUTS] + [
         c for c in ("seeds", "determined", "steady") if c in table] + [
         "p_stable", "p_in_plane", "p_3d", "p_3d_low", "p_3d_high",
         "tilt_median", "tilt_median_low", "tilt_median_high"]
@@ -53,6 +51,7 @@ def command(args):
                                            perturbation_ensemble=PERTURBATION_ENSEMBLE),
                     shown, declarations=columns.SUMMARY_COLUMNS)
     if args.figure is not None:
-        save_distribution_figure(table, frame, args.figure)
+        use_agg()
+        figures.save_distribution_figure(table, frame, args.figure)
         print(f"figure: {args.figure}")
     return 0

@@ -3,11 +3,11 @@ when re-run; also reruns of a sweep's failed cases (``--rerun-failed``)."""
 import math
 import sys
 
-from ..shapes.circle import PERTURBATION_ENSEMBLE
-from ..config import DEFAULT_AUTO_CHUNK_SIZE, DEFAULT_CHUNK_SIZE, DEFAULT_N, SEED_TARGETS
+from ..defaults import DEFAULT_AUTO_CHUNK_SIZE, DEFAULT_CHUNK_SIZE, DEFAULT_N, SEED_TARGETS
+from ..shapes.tilted_circle import PERTURBATION_ENSEMBLE
 from .common import (
     EXIT_FAILED_RUN, HelpFormatter, Parser, add_integration_options, check_auto_options,
-    interrupted, real, save_distribution_figure, use_agg,
+    interrupted, real, use_agg,
 )
 
 
@@ -43,6 +43,28 @@ def add_parser(commands):
         "cases are kept). Exit 1: some case failed (its row says why; see --rerun-failed).",
         formatter_class=HelpFormatter,
     )
+    _add_case_options(sweep)
+    integration = sweep.add_argument_group("integration of each case")
+    add_integration_options(integration)
+    integration.add_argument("--no-early-stop", action="store_true",
+                             help="always integrate to --t-end (default: stop once the shape "
+                             "and tilt are steady, see docs/sweeps.md)")
+    sharp = sweep.add_argument_group(
+        "--seeds auto: seeds added per point until it is deterministic (every seed in one "
+        "regime, tilts within 1 deg, aspect ratios within 0.1), sharp (both targets met) or at "
+        "--max-seeds")
+    for name, (metavar, text) in SEED_TARGET_HELP.items():
+        sharp.add_argument("--" + name.replace("_", "-"), type=real if metavar != "K" else int,
+                           default=None, metavar=metavar,
+                           help=f"{text} (default: {SEED_TARGETS[name][1]})")
+    _add_output_options(sweep.add_argument_group("output"))
+    _add_backend_options(
+        sweep.add_argument_group("where the cases run (default: this machine's threads)"))
+    return sweep
+
+
+def _add_case_options(sweep):
+    """The options that say which cases a sweep runs (a grid, or a cases file)."""
     grid = sweep.add_argument_group("cases (a grid, or --cases FILE)")
     grid.add_argument("--g0", metavar="START:STOP:NUM|v1,v2,...",
                       help="g0 values (gravity over bending stiffness, dimensionless)")
@@ -62,20 +84,10 @@ def add_parser(commands):
                       "[, n, seed, perturbation, initial, initial_case_id] instead of a grid "
                       "(initial: a point file or results per row, paths relative to FILE; "
                       "theta0_deg then left empty)")
-    integration = sweep.add_argument_group("integration of each case")
-    add_integration_options(integration)
-    integration.add_argument("--no-early-stop", action="store_true",
-                             help="always integrate to --t-end (default: stop once the shape "
-                             "and tilt are steady, see docs/sweeps.md)")
-    sharp = sweep.add_argument_group(
-        "--seeds auto: seeds added per point until it is deterministic (every seed in one "
-        "regime, tilts within 1 deg, aspect ratios within 0.1), sharp (both targets met) or at "
-        "--max-seeds")
-    for name, (metavar, text) in SEED_TARGET_HELP.items():
-        sharp.add_argument("--" + name.replace("_", "-"), type=real if metavar != "K" else int,
-                           default=None, metavar=metavar,
-                           help=f"{text} (default: {SEED_TARGETS[name][1]})")
-    output = sweep.add_argument_group("output")
+
+
+def _add_output_options(output):
+    """What a sweep writes and shows, and its threads and chunks."""
     output.add_argument("--snapshots-for", metavar="CASE_IDS", default="",
                        help="case ids (v1,v2,...) whose trajectories are stored as snapshots")
     output.add_argument("--snapshots", type=int, default=101, metavar="K",
@@ -96,7 +108,10 @@ def add_parser(commands):
     output.add_argument("--progress-every", type=real, default=30.0, metavar="SECONDS",
                        help="progress line interval, in seconds of wall time, when stderr is "
                        "not a terminal (a log file)")
-    where = sweep.add_argument_group("where the cases run (default: this machine's threads)")
+
+
+def _add_backend_options(where):
+    """Where the cases run: Dask, job-array shards, reruns of failed cases."""
     where.add_argument("--scheduler", metavar="ADDRESS",
                        help="send chunks as tasks to the Dask scheduler at ADDRESS "
                        "(tcp://host:8786); finished chunks come back and are written here")
@@ -112,10 +127,9 @@ def add_parser(commands):
                        help="rerun only DIR's failed cases with this command's --method, --rtol "
                        "and --atol; rows replaced, earlier rows kept in DIR/_reruns/ "
                        "(resumable: re-run the same command)")
-    return sweep
 
 
-#: --seeds auto's targets (config.SEED_TARGETS: field and default): metavar, help.
+#: --seeds auto's targets (defaults.SEED_TARGETS: field and default): metavar, help.
 SEED_TARGET_HELP = {
     "p_halfwidth": ("P", "largest half-width of each regime probability's 95%% Wilson "
                     "interval"),
@@ -125,8 +139,8 @@ SEED_TARGET_HELP = {
     "max_seeds": ("K", "seeds at most per point"),
     "check_seeds": ("K", "seeds of each point whose runs are samples (its seeds end in "
                     "different regimes, or a twin ends elsewhere) rerun at the twins' stricter "
-                    "tolerances to check its distribution (summary.compare); that point's "
-                    "later seeds run without twins; 0: no check, twins throughout"),
+                    "tolerances to check its distribution (outcome_statistics.compare); that "
+                    "point's later seeds run without twins; 0: no check, twins throughout"),
 }
 RERUN_OPTIONS = ("method", "rtol", "atol")  # what --rerun-failed takes from the command line
 #: Options that say where and how a rerun runs, not what: they apply with --rerun-failed.
@@ -191,8 +205,8 @@ def _sweep_config(args, sweeps):
 
 def _parse_seeds(args):
     """``--seeds K|auto`` into an int or "auto", and the --seeds auto targets
-    (``seeding.SeedTargets``, or None), each refused where it does not apply."""
-    from .. import seeding
+    (``seeds_auto_rule.SeedTargets``, or None), each refused where it does not apply."""
+    from .. import seeds_auto_rule
 
     if args.seeds != "auto":
         try:
@@ -215,7 +229,7 @@ def _parse_seeds(args):
         if value is not None:
             raise ValueError(f"{flag} does not apply with --seeds auto (its rounds are planned "
                              "from the grid's points as the seeds come in)")
-    return seeding.SeedTargets(**given).check()
+    return seeds_auto_rule.SeedTargets(**given).check()
 
 
 def _check_rerun_options(args):
@@ -251,9 +265,45 @@ def _sampled_cells_text(sampled, config, targets, out):
 
 
 def command(args):
+    from .. import figures, outcome_statistics
+
+    backend = _backend_options(args)
+    try:
+        out, config, frame, stops = _run(args, backend)
+    except KeyboardInterrupt as stopped:  # sweeps.SweepInterrupted, or a Ctrl-C before it
+        done = (f"{stopped.done} of {stopped.total} cases done and kept in {stopped.out}; "
+                if hasattr(stopped, "done") else "")
+        return interrupted(getattr(stopped, "signum", 2),
+                            f"{done}re-run the same command to resume")
+    counts = outcome_statistics.outcome_counts(frame)
+    _print_outcomes(counts, out, config, frame)
+    seeds_auto = args.rerun_failed is None and args.seeds == "auto"
+    if seeds_auto:
+        _print_seeds_auto(outcome_statistics.stop_counts(stops), stops, out, config,
+                          _parse_seeds(args))
+    if args.figure:
+        use_agg()
+        if seeds_auto:
+            figures.save_distribution_figure(outcome_statistics.summarize(frame), frame,
+                                             args.figure)
+        else:
+            figures.save(figures.phase_diagram(frame), args.figure)
+        print(f"{'distribution summary' if seeds_auto else 'phase diagram'}: {args.figure}")
+    if counts["failed"]:
+        print(f"{counts['failed']} of {counts['cases']} cases failed (column 'status'); exit "
+              f"status {EXIT_FAILED_RUN}; rerun them with: "
+              f"{outcome_statistics.RERUN_COMMAND.format(out=out)} (or another --rtol)",
+              file=sys.stderr)
+        return EXIT_FAILED_RUN
+    return 0
+
+
+def _backend_options(args):
+    """The options of how a sweep runs (threads, Dask, progress), checked: keyword
+    arguments of ``sweeps.run_sweep``."""
     import numba
 
-    from .. import figures, sweeps, validation
+    from .. import validation
 
     if args.figure is not None:
         validation.check_output_file("--figure", args.figure)
@@ -270,42 +320,45 @@ def command(args):
         raise ValueError("give --scheduler ADDRESS or --dask, not both")
     if not args.progress_every > 0:
         raise ValueError(f"--progress-every must be > 0, got {args.progress_every:g}")
-    backend = dict(threads=args.threads, quiet=args.quiet, command_line=sys.argv,
-                   scheduler=args.scheduler, local_cluster=args.dask, workers=args.workers,
-                   progress_interval=args.progress_every)
-    try:
-        if args.rerun_failed is not None:
-            _check_rerun_options(args)
-            out = args.rerun_failed
-            settings = {k: getattr(args, k) for k in RERUN_OPTIONS}
-            frame, reran = sweeps.rerun_failed(out, **settings, **backend)
-            print(f"reran {reran} failed case(s) with " + ", ".join(
-                f"{k} {getattr(args, k)}" for k in RERUN_OPTIONS))
-            config = sweeps.SweepConfig(cases=[])
-        else:
-            if args.out is None:
-                raise ValueError("a sweep needs --out DIR (or --rerun-failed DIR)")
-            out = validation.check_output_directory("--out", args.out)
-            targets = _parse_seeds(args)
-            config = _sweep_config(args, sweeps)
-            if targets is None:
-                frame = sweeps.run_sweep(config, out, shard=None if args.shard is None
-                                         else _parse_shard(args.shard), **backend)
-            else:
-                frame, stops = sweeps.run_seeds_auto(
-                    config, out, targets, command_line=sys.argv,
-                    run_round=lambda round_config, directory, weights: sweeps.run_sweep(
-                        round_config, directory, weights=weights, **backend),
-                    announce=None if args.quiet else lambda line: print(
-                        line, file=sys.stderr, flush=True))
-    except KeyboardInterrupt as stopped:  # sweeps.SweepInterrupted, or a Ctrl-C before it
-        done = (f"{stopped.done} of {stopped.total} cases done and kept in {stopped.out}; "
-                if hasattr(stopped, "done") else "")
-        return interrupted(getattr(stopped, "signum", 2),
-                            f"{done}re-run the same command to resume")
-    from .. import seeding, summary
+    return dict(threads=args.threads, quiet=args.quiet, command_line=sys.argv,
+                scheduler=args.scheduler, local_cluster=args.dask, workers=args.workers,
+                progress_interval=args.progress_every)
 
-    counts = summary.outcome_counts(frame)
+
+def _run(args, backend):
+    """Rerun a sweep's failed cases, or run a sweep (fixed seeds or ``--seeds auto``):
+    (directory, SweepConfig, rows, the ``--seeds auto`` stop table or None)."""
+    from .. import sweeps, validation
+
+    stops = None
+    if args.rerun_failed is not None:
+        _check_rerun_options(args)
+        out = args.rerun_failed
+        settings = {k: getattr(args, k) for k in RERUN_OPTIONS}
+        frame, reran = sweeps.rerun_failed(out, **settings, **backend)
+        print(f"reran {reran} failed case(s) with " + ", ".join(
+            f"{k} {getattr(args, k)}" for k in RERUN_OPTIONS))
+        return out, sweeps.SweepConfig(cases=[]), frame, stops
+    if args.out is None:
+        raise ValueError("a sweep needs --out DIR (or --rerun-failed DIR)")
+    out = validation.check_output_directory("--out", args.out)
+    targets = _parse_seeds(args)
+    config = _sweep_config(args, sweeps)
+    if targets is None:
+        frame = sweeps.run_sweep(config, out, shard=None if args.shard is None
+                                 else _parse_shard(args.shard), **backend)
+    else:
+        frame, stops = sweeps.run_seeds_auto(
+            config, out, targets, command_line=sys.argv,
+            run_round=lambda round_config, directory, weights: sweeps.run_sweep(
+                round_config, directory, weights=weights, **backend),
+            announce=None if args.quiet else lambda line: print(
+                line, file=sys.stderr, flush=True))
+    return out, config, frame, stops
+
+
+def _print_outcomes(counts, out, config, frame):
+    """The cases by regime, and those not resolved or not determined."""
     print(f"{counts['cases']} cases in {out}: "
           + ", ".join(f"{k} {v}" for k, v in counts["regimes"].items()))
     if counts["unresolved"]:
@@ -322,32 +375,22 @@ def command(args):
               "tilt is a sample of an ill-conditioned transient, not an outcome (regimes "
               "among them: " + ", ".join(
                   f"{k} {v}" for k, v in counts["undetermined_regimes"].items()) + ")")
-    seeds_auto = args.rerun_failed is None and args.seeds == "auto"
-    if seeds_auto:
-        stopped = summary.stop_counts(stops)
-        print(f"{stopped['points']} points, seeds until sharp: " + ", ".join(
-            f"{k} {v}" for k, v in stopped["reasons"].items())
-            + f" (seeds per point {stopped['seeds_min']}-{stopped['seeds_max']}; why each "
-            f"stopped: {out}/seeds_auto.parquet; per point: loopsim summary {out})")
-        sampled = stops[stops["runs"] == "samples"] if "runs" in stops else stops.iloc[:0]
-        if len(sampled):
-            print(f"{len(sampled)} points' runs are samples (seeds in several regimes, or a "
-                  "twin ending elsewhere): " + _sampled_cells_text(sampled, config, targets,
-                                                                   out))
-        failed = stopped["reasons"].get(seeding.FAILED, 0)
-        if failed:
-            print(f"{failed} points with no successful seed (stop reason failed): no "
-                  "distribution, no check")
-    if args.figure:
-        use_agg()
-        if seeds_auto:
-            save_distribution_figure(summary.summarize(frame), frame, args.figure)
-        else:
-            figures.save(figures.phase_diagram(frame), args.figure)
-        print(f"{'distribution summary' if seeds_auto else 'phase diagram'}: {args.figure}")
-    if counts["failed"]:
-        print(f"{counts['failed']} of {counts['cases']} cases failed (column 'status'); exit "
-              f"status {EXIT_FAILED_RUN}; rerun them with: "
-              f"{summary.RERUN_COMMAND.format(out=out)} (or another --rtol)", file=sys.stderr)
-        return EXIT_FAILED_RUN
-    return 0
+
+
+def _print_seeds_auto(stopped, stops, out, config, targets):
+    """Why the points of a ``--seeds auto`` sweep stopped, which were samples, and which
+    had no successful seed."""
+    from .. import seeds_auto_rule
+
+    print(f"{stopped['points']} points, seeds until sharp: " + ", ".join(
+        f"{k} {v}" for k, v in stopped["reasons"].items())
+        + f" (seeds per point {stopped['seeds_min']}-{stopped['seeds_max']}; why each "
+        f"stopped: {out}/seeds_auto.parquet; per point: loopsim summary {out})")
+    sampled = stops[stops["runs"] == "samples"] if "runs" in stops else stops.iloc[:0]
+    if len(sampled):
+        print(f"{len(sampled)} points' runs are samples (seeds in several regimes, or a "
+              "twin ending elsewhere): " + _sampled_cells_text(sampled, config, targets, out))
+    failed = stopped["reasons"].get(seeds_auto_rule.FAILED, 0)
+    if failed:
+        print(f"{failed} points with no successful seed (stop reason failed): no "
+              "distribution, no check")

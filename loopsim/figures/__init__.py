@@ -40,11 +40,12 @@ Regime colours are :data:`REGIME_STYLE` (the paper's: stable dark purple,
 in-plane green-blue, 3D yellow); cases not resolved at their n are hollow.
 """
 from .. import diagnostics, spectral, validation  # noqa: F401  (names of the former module)
-from ..stability import circle, paper  # noqa: F401  (names of the former module)
+from ..stability import full_linear, paper  # noqa: F401  (names of the former module)
 from .animation import animate, animation_figure, frame_indices, load_trajectory, write_animation
 from .distributions import (
-    aspect_distribution, check_one_cell_per_point, distribution_summary, probability_phase_diagram,
-    regime_pies, tilt_distribution, wedge_marker,
+    BRANCH_Q_MAX, aspect_distribution, check_one_cell_per_point, distribution_summary,
+    probability_phase_diagram, regime_pies, save_distribution_figure, tilt_distribution,
+    wedge_marker,
 )
 from .evolution import (
     evolution, evolution_rows, settling_index, snapshot_indices, tension_figure, tension_on_shape,
@@ -66,7 +67,7 @@ from .suite import (
 from .terminal import aspect_ratio, q_and_tilt, seed_distributions
 
 __all__ = [
-    "ASPECT_LABEL", "CURVE_POINTS", "FIGURE_NAMES", "PAPER_BAND", "REGIME_STYLE", "TIME_CMAP",
+    "ASPECT_LABEL", "BRANCH_Q_MAX", "CURVE_POINTS", "FIGURE_NAMES", "PAPER_BAND", "REGIME_STYLE", "TIME_CMAP",
     "animate", "animation_figure", "frame_indices", "load_trajectory", "write_animation",
     "aspect_distribution", "aspect_ratio", "branch_lines", "centred_curve",
     "check_one_cell_per_point", "coefficients", "default_thresholds", "distribution_summary",
@@ -74,7 +75,7 @@ __all__ = [
     "mark_undetermined", "merged_legend_entries", "model_outcomes", "model_text", "new_figure",
     "nonlocal_thresholds", "order_column", "orders_text", "phase_diagram", "phase_diagrams",
     "plane_view", "probability_phase_diagram", "q_and_tilt", "q_lines", "read_run", "read_sweep",
-    "regime_key", "regime_pies", "regime_style", "resolved_mask", "run_title", "save",
+    "regime_key", "regime_pies", "regime_style", "resolved_mask", "run_title", "save", "save_distribution_figure",
     "scatter_regimes", "seed_distributions", "settling_index", "side_view_basis", "single_axes",
     "snapshot_indices", "stability", "stability_data", "sweep_kind", "sweep_label",
     "tension_figure", "tension_on_shape", "tilt_distribution", "time_colours", "trajectory",

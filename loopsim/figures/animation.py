@@ -21,14 +21,15 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.colors import TwoSlopeNorm
 
-from .. import diagnostics, outputs, spectral, validation
+from .. import diagnostics, render_defaults, spectral, validation
 from .style import ASPECT_LABEL, coefficients
 
 #: Default most frames drawn, frames per second and resolution, and their bounds
-#: (``loopsim.outputs``, where ``loopsim animate --help`` reads them without NumPy).
-FRAMES, FPS, DPI = outputs.ANIMATION_FRAMES, outputs.ANIMATION_FPS, outputs.ANIMATION_DPI
-MAX_FRAMES, MAX_FPS = outputs.ANIMATION_MAX_FRAMES, outputs.ANIMATION_MAX_FPS
-MIN_DPI, MAX_DPI = outputs.ANIMATION_DPI_RANGE
+#: (``loopsim.render_defaults``, where ``loopsim animate --help`` reads them without NumPy).
+FRAMES, FPS, DPI = (render_defaults.ANIMATION_FRAMES, render_defaults.ANIMATION_FPS,
+                    render_defaults.ANIMATION_DPI)
+MAX_FRAMES, MAX_FPS = render_defaults.ANIMATION_MAX_FRAMES, render_defaults.ANIMATION_MAX_FPS
+MIN_DPI, MAX_DPI = render_defaults.ANIMATION_DPI_RANGE
 #: Figure size in inches (width, height).
 FIGSIZE = (8.4, 3.8)
 #: File types written, by extension.
@@ -165,7 +166,7 @@ def write_animation(trajectory, out, title="", frames=FRAMES, fps=FPS, dpi=DPI):
     Returns the number of frames written."""
     from matplotlib.animation import FFMpegWriter, FuncAnimation, PillowWriter
 
-    from .. import io
+    from .. import storage
 
     out = check_output(out)
     frames = validation.check_count("--frames", frames, 2, MAX_FRAMES,
@@ -177,7 +178,7 @@ def write_animation(trajectory, out, title="", frames=FRAMES, fps=FPS, dpi=DPI):
         movie = FuncAnimation(fig, update, frames=len(indices), blit=False)
         writer = (PillowWriter(fps=fps) if out.lower().endswith(".gif")
                   else FFMpegWriter(fps=fps))
-        io.write_file_atomically(out, lambda tmp: movie.save(tmp, writer=writer, dpi=dpi))
+        storage.write_file_atomically(out, lambda tmp: movie.save(tmp, writer=writer, dpi=dpi))
     finally:
         plt.close(fig)
     return len(indices)
@@ -190,25 +191,25 @@ def load_trajectory(source, case_id=None):
     that is not in the sweep or has no snapshots."""
     import pandas as pd
 
-    from .. import io
+    from .. import storage
     from .suite import read_run, run_title
 
     if isinstance(source, pd.DataFrame):
         return source, ""
     if hasattr(source, "multiplier") and hasattr(source, "summary"):  # a SimulationResult
-        return io.trajectory_table(source).to_pandas(), run_title(source.summary())
+        return storage.trajectory_table(source).to_pandas(), run_title(source.summary())
     path = os.fspath(source)
     if os.path.isdir(path):
         if case_id is None:
             raise ValueError(f"{path!r} is a sweep directory: name the case with --case-id K "
                              "(one traced with --snapshots-for)")
         case_id = validation.check_integer("--case-id", case_id, 0)
-        frame = io.read_results(path)
+        frame = storage.read_results(path)
         if case_id not in set(frame["case_id"].tolist()):
             raise ValueError(f"no finished case {case_id} in sweep {path!r} (its case ids: "
                              f"{int(frame['case_id'].min()) if len(frame) else '-'}.."
                              f"{int(frame['case_id'].max()) if len(frame) else '-'})")
-        snapshots = io.read_snapshots(path)
+        snapshots = storage.read_snapshots(path)
         if not len(snapshots) or case_id not in set(snapshots["case_id"].tolist()):
             raise ValueError(f"case {case_id} of sweep {path!r} has no snapshots: rerun it "
                              f"with --snapshots-for {case_id} --snapshots 80 (or run it "

@@ -1,11 +1,17 @@
 """Outcomes over seeds as distributions: regime probabilities per cell, terminal tilt and
 aspect ratio with their medians and intervals (tables of ``loopsim.summarize``)."""
+import math
+
 import matplotlib.pyplot as plt
 import numpy as np
 
-from ..stability import circle
+from ..stability import branch as steady, full_linear
 from .linear import branch_lines
-from .style import REGIME_STYLE, single_axes
+from .style import REGIME_STYLE, frame_model, save, single_axes
+
+#: Where the steady branch drawn under a distribution summary ends, at most (its cost
+#: grows with it: about 25 s to q = 25 at n = 12 on one core).
+BRANCH_Q_MAX = 25.0
 
 
 def wedge_marker(start, stop, points=24):
@@ -93,7 +99,7 @@ def probability_phase_diagram(cells, frame=None, ax=None, style="pie"):
                        label="some seeds not steady at t_end")
     theta = np.linspace(1.0, 90.0, 300)
     for sector, line in (("in-plane", "--"), ("out-of-plane", ":")):
-        q_sector = circle.critical_q(16, sector)
+        q_sector = full_linear.critical_q(16, sector)
         ax.plot(theta, 3 * q_sector / np.sin(np.radians(theta)), "k", ls=line, lw=1.0,
                 label=f"{sector} threshold, q = {q_sector:.3f}")
     ax.set_xlim(0, 92)
@@ -130,7 +136,7 @@ def tilt_distribution(cells, frame=None, ax=None):
                       cells["tilt_median_high"] - cells["tilt_median"]],
                 fmt="o", ms=3.5, color="#3b0f70", elinewidth=1.6, zorder=3,
                 label="median, 95% interval")
-    q_out = circle.critical_q(16, "out-of-plane")
+    q_out = full_linear.critical_q(16, "out-of-plane")
     ax.axvline(q_out, color="k", ls=":", lw=1.0, label=f"out-of-plane threshold, q = {q_out:.3f}")
     ax.set_xlabel(r"$q_0 = g_0 \sin\theta_0 / 3$")
     ax.set_ylabel(r"terminal tilt $\theta$ (deg)")
@@ -170,7 +176,7 @@ def aspect_distribution(cells, frame=None, branch=None, ax=None):
 
 
 def distribution_summary(cells, frame, branch=None):
-    """The panels of a summary table (``summary.summarize``) and its rows: the regime
+    """The panels of a summary table (``outcome_statistics.summarize``) and its rows: the regime
     probabilities per cell (:func:`probability_phase_diagram`), the terminal tilt over the seeds
     (:func:`tilt_distribution`) and, when the table has terminal q, the aspect ratio
     over the steady branch ``branch`` (:func:`aspect_distribution`)."""
@@ -181,3 +187,16 @@ def distribution_summary(cells, frame, branch=None):
     if panels == 3:
         aspect_distribution(cells, frame, branch=branch, ax=axes[2])
     return fig
+
+
+def save_distribution_figure(table, frame, path, dpi=150):
+    """Draw a summary table and its rows (:func:`distribution_summary`) to ``path``: for
+    the local model over its steady branch up to the largest terminal q seen, rounded up
+    to a multiple of 5 (at most :data:`BRANCH_Q_MAX`)."""
+    branch = None
+    q_final = frame["q_final"].to_numpy(float) if "q_final" in frame else []
+    q_seen = [float(q) for q in q_final if q == q]
+    if frame_model(frame).name == "local" and q_seen:
+        branch = steady.steady_branch_to(
+            min(BRANCH_Q_MAX, 5.0 * math.ceil(1.05 * max(q_seen) / 5.0) or 5.0))
+    save(distribution_summary(table, frame, branch=branch), path, dpi=dpi)

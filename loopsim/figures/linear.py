@@ -3,7 +3,7 @@ import numpy as np
 import pandas as pd
 
 from .. import models
-from ..stability import circle, paper
+from ..stability import branch, full_linear, paper
 from .style import model_text, new_figure, single_axes
 
 
@@ -12,8 +12,8 @@ def stability_data(n=16, q_values=None, n_values=range(3, 17), theta0_deg=90.0):
     out_of_plane: largest growth rates at truncation n) and ``critical`` (n, in_plane,
     out_of_plane, paper, corrected: critical q against n; NaN where none)."""
     q_values = np.linspace(0.0, 20.0, 81) if q_values is None else np.asarray(q_values, float)
-    growth = pd.DataFrame(circle.paper_comparison(q_values, n, theta0_deg))
-    critical = pd.DataFrame(circle.critical_q_table(list(n_values), theta0_deg),
+    growth = pd.DataFrame(full_linear.paper_comparison(q_values, n, theta0_deg))
+    critical = pd.DataFrame(full_linear.critical_q_table(list(n_values), theta0_deg),
                             columns=["n", "in_plane", "out_of_plane", "paper", "corrected"])
     growth.attrs["n"] = int(n)
     return growth, critical
@@ -49,18 +49,12 @@ def stability(growth, critical, axes=None):
 
 
 def load_branch(n=12, q_max=25.0):
-    """The steady branch from ``stability.branch.steady_branch`` (a DataFrame), or None
-    with the reason when that module or function is not there."""
-    try:
-        from ..stability import branch as steady
-    except ImportError as exc:
-        return None, f"no steady branch: {exc}"
-    function = getattr(steady, "steady_branch", None)
-    if function is None:
-        return None, "no steady branch: loopsim.stability.branch has no steady_branch()"
-    frame = function(n=n, q_max=q_max)
-    frame.attrs.setdefault("n", n)
-    return frame, None
+    """(``stability.branch.steady_branch(n, q_max)``, None): the pair the figures once
+    took, when the branch module was optional.  Deprecated: call ``steady_branch``."""
+    from .._moved import warn_moved
+
+    warn_moved("loopsim.figures.load_branch", "loopsim.stability.branch.steady_branch")
+    return branch.steady_branch(n=n, q_max=q_max), None
 
 
 def growth_rates(n=16, q_values=None, theta0_deg=90.0, w=None, ax=None, model=None):
@@ -70,7 +64,7 @@ def growth_rates(n=16, q_values=None, theta0_deg=90.0, w=None, ax=None, model=No
     kwargs = dict({} if w is None else dict(w=w), **({} if model is None else dict(model=model)))
     fig, ax = single_axes(ax, (6.4, 4.2))
     q_values = np.linspace(0.0, 20.0, 81) if q_values is None else np.asarray(q_values, float)
-    rows = circle.paper_comparison(q_values, n, theta0_deg, **kwargs)
+    rows = full_linear.paper_comparison(q_values, n, theta0_deg, **kwargs)
     get = lambda key: [r[key] for r in rows]  # noqa: E731
     ax.plot(q_values, get("paper"), "k--", label="paper's operator (§4)")
     ax.plot(q_values, get("out_of_plane"), "C0-", lw=2, label="full J, out-of-plane")
@@ -78,7 +72,7 @@ def growth_rates(n=16, q_values=None, theta0_deg=90.0, w=None, ax=None, model=No
     ax.plot(q_values, get("in_plane"), "C3-", lw=2, label="full J, in-plane")
     ax.axhline(0.0, color="0.6", lw=0.8)
     for sector, color in (("in-plane", "C3"), ("out-of-plane", "C0")):
-        qc = circle.critical_q(n, sector, theta0_deg, **kwargs)
+        qc = full_linear.critical_q(n, sector, theta0_deg, **kwargs)
         ax.axvline(qc, color=color, lw=0.8, ls="--")
         ax.annotate(f"{qc:.4f}", (qc, -14), color=color, rotation=90, ha="right", va="bottom")
     qp = paper.critical_q(n)

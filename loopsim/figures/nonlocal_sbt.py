@@ -3,7 +3,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from .. import models
-from ..stability import circle
+from ..stability import full_linear
 from .style import REGIME_STYLE, frame_model, order_column, orders_text, single_axes
 
 
@@ -13,8 +13,8 @@ def nonlocal_thresholds(eps_values=(1e-2, 3e-3, 1e-3, 1e-4, 1e-6, 1e-9, 1e-12), 
     fig, ax = single_axes(ax, (6.4, 4.2))
     eps = np.sort(np.asarray(eps_values, dtype=float))
     for sector, color in (("in-plane", "C3"), ("out-of-plane", "C0")):
-        local = circle.critical_q(n, sector)
-        q = [circle.critical_q(n, sector, model=models.choose("nonlocal", e)) for e in eps]
+        local = full_linear.critical_q(n, sector)
+        q = [full_linear.critical_q(n, sector, model=models.choose("nonlocal", e)) for e in eps]
         ax.semilogx(eps, q, "o-", color=color, label=f"nonlocal SBT, {sector}")
         ax.axhline(local, color=color, ls="--", lw=1.0, label=f"local SBT, {sector}: {local:.4f}")
     ax.invert_xaxis()
@@ -48,7 +48,7 @@ def model_outcomes(frames):
         tilt.plot([0, 90], [0, 90], color="0.8", lw=0.8, zorder=1)
         order = max(int(frame[order_column(frame)].max()), 3)
         for sector, style in (("in-plane", "--"), ("out-of-plane", ":")):
-            aspect.axvline(circle.critical_q(order, sector, model=model), color="k", ls=style,
+            aspect.axvline(full_linear.critical_q(order, sector, model=model), color="k", ls=style,
                            lw=1.0, label=f"circle, {sector}")
         failed = int((frame["regime"] == "failed").sum())
         name = "local SBT" if model.name == "local" else f"nonlocal SBT, ε = {model.slenderness:g}"

@@ -1,7 +1,7 @@
 """Figs. 5 and 9: phase diagrams of one or several sweeps (g0 against θ0 by regime)."""
 import numpy as np
 
-from ..stability import circle, paper
+from ..stability import full_linear, paper
 from .style import (
     PAPER_BAND, REGIME_STYLE, frame_model, mark_undetermined, merged_legend_entries, model_text,
     new_figure, order_column, orders_text, single_axes,
@@ -36,7 +36,7 @@ def phase_diagram(frame, ax=None, paper_band=False):
     ax.plot(theta, 3 * q_paper / np.sin(np.radians(theta)), "k-", lw=1.2,
             label=f"paper's linear\nstability, q = {q_paper:.3f}")
     for sector, style in (("in-plane", "--"), ("out-of-plane", ":")):
-        q_sector = circle.critical_q(max(order, 3), sector, model=model)
+        q_sector = full_linear.critical_q(max(order, 3), sector, model=model)
         ax.plot(theta, 3 * q_sector / np.sin(np.radians(theta)), "k", ls=style, lw=1.2,
                 label=f"full linearisation,\n{sector}, q = {q_sector:.3f}")
     if paper_band:

@@ -11,7 +11,7 @@ import numpy as np
 from matplotlib.lines import Line2D
 
 from .. import models, spectral
-from ..stability import circle, paper
+from ..stability import full_linear, paper
 
 REGIME_STYLE = {
     "stable": dict(color="#3b0f70", marker="o", label="stable"),
@@ -72,10 +72,10 @@ PAPER_BAND = (10.5, 18.5)
 def save(fig, path, dpi=200):
     """Write ``fig`` to ``path`` (its directory made if absent; atomically: a failed write
     leaves no file) and close it."""
-    from .. import io
+    from .. import storage
 
     try:
-        io.write_file_atomically(path, lambda tmp: fig.savefig(
+        storage.write_file_atomically(path, lambda tmp: fig.savefig(
             tmp, dpi=dpi, format=os.path.splitext(path)[1][1:] or None))
     finally:
         plt.close(fig)
@@ -170,8 +170,8 @@ def scatter_regimes(ax, frame, xcol, ycol, shift=None, size=20, label_suffix="")
 
 def default_thresholds(n=16):
     """q thresholds: the paper's operator and the full linearisation (in-plane, out-of-plane)."""
-    return dict(paper=paper.critical_q(20), in_plane=circle.critical_q(max(n, 3), "in-plane"),
-                out_of_plane=circle.critical_q(max(n, 3), "out-of-plane"))
+    return dict(paper=paper.critical_q(20), in_plane=full_linear.critical_q(max(n, 3), "in-plane"),
+                out_of_plane=full_linear.critical_q(max(n, 3), "out-of-plane"))
 
 
 def q_lines(ax, thresholds, vertical=True, band=True):

@@ -5,9 +5,10 @@ import numpy as np
 import pandas as pd
 
 from .. import validation
+from ..stability.branch import steady_branch
 from .evolution import evolution, evolution_rows, tension_figure
 from .gallery import gallery
-from .linear import load_branch, stability, stability_data
+from .linear import stability, stability_data
 from .phase import phase_diagram, phase_diagrams
 from .style import orders_text, save as save_figure
 from .terminal import aspect_ratio, q_and_tilt, seed_distributions
@@ -19,18 +20,18 @@ FIGURE_NAMES = ("stability", "gallery", "phase", "q_tilt", "aspect", "phase_n", 
 
 def read_run(path):
     """(trajectory DataFrame, summary dict) of a ``loopsim run --out`` file, read as sweep
-    chunks are (``io.read_table_checked``: page checksums and content hash verified).
+    chunks are (``storage.read_table_checked``: page checksums and content hash verified).
     ValueError, one line: a file that is not a run file, cannot be read, or is damaged
     (``'PATH' is damaged (...)``)."""
-    from .. import io
+    from .. import storage
 
     try:
-        meta = io.read_metadata(path)
+        meta = storage.read_metadata(path)
         if "summary" not in meta:
             raise ValueError(f"{path!r} is not a run file (written by 'loopsim run --out'): "
                              "no run summary in its metadata")
-        frame = io.read_table_checked(path).to_pandas()
-    except io.DamagedFile as exc:
+        frame = storage.read_table_checked(path).to_pandas()
+    except storage.DamagedFile as exc:
         raise ValueError(f"{exc}; run it again (loopsim run --out)") from None
     except (OSError, ValueError) as exc:
         raise ValueError(f"cannot read {path!r}: {str(exc).splitlines()[0]}") from None
@@ -41,12 +42,12 @@ def read_run(path):
 
 
 def read_sweep(path):
-    """A sweep directory's table (``io.read_results``); ValueError, one line, if it cannot
+    """A sweep directory's table (``storage.read_results``); ValueError, one line, if it cannot
     be read or holds no finished case."""
-    from .. import io
+    from .. import storage
 
     try:
-        frame = io.read_results(path)
+        frame = storage.read_results(path)
     except (OSError, ValueError) as exc:
         raise ValueError(f"cannot read sweep {path!r}: {str(exc).splitlines()[0]}") from None
     if not len(frame):
@@ -94,6 +95,28 @@ def write_figures(sweep_dir, others=(), out=".", only=None, gallery_theta0=30.0,
     :data:`FIGURE_NAMES`.  Bad input raises ValueError, before ``out`` (made if absent)
     is created or anything drawn.
     """
+    only = _check_figure_options(only, dpi, gallery_theta0, branch_n, out)
+    if not os.path.isdir(sweep_dir):
+        raise ValueError(f"no sweep directory at {sweep_dir!r}")
+    main = read_sweep(sweep_dir)
+    sweeps, runs = _read_others(others)
+    os.makedirs(out, exist_ok=True)
+    written = {}
+
+    def save(name, fig):
+        path = save_figure(fig, os.path.join(out, f"{name}.png"), dpi=dpi)
+        written[name] = path
+        log(f"{name}: {path}")
+
+    _draw_sweep_figures(save, only, main, sweeps, gallery_theta0, stability_n,
+                        branch_n if branch else None, log)
+    _draw_run_figures(save, only, runs)
+    return written
+
+
+def _check_figure_options(only, dpi, gallery_theta0, branch_n, out):
+    """The figure names asked for (a set), after :func:`write_figures`' options are
+    checked; ValueError, one line, on the first that is not right."""
     only = set(FIGURE_NAMES if only is None else only)
     unknown = only - set(FIGURE_NAMES)
     if unknown:
@@ -105,9 +128,12 @@ def write_figures(sweep_dir, others=(), out=".", only=None, gallery_theta0=30.0,
     validation.check_count("branch_n", branch_n, 4, validation.MAX_BRANCH_N,
                            "the continuation's cost grows like n^3 per point")
     validation.check_output_directory("out", out)
-    if not os.path.isdir(sweep_dir):
-        raise ValueError(f"no sweep directory at {sweep_dir!r}")
-    main = read_sweep(sweep_dir)
+    return only
+
+
+def _read_others(others):
+    """The other sweeps by kind ({"grid", "seeds", "reference"}: [(path, frame)]) and the
+    run files ([(path, trajectory, summary)]) of :func:`write_figures`' ``others``."""
     sweeps, runs = {"grid": [], "seeds": [], "reference": []}, []
     for path in others:
         if os.path.isdir(path):
@@ -117,14 +143,12 @@ def write_figures(sweep_dir, others=(), out=".", only=None, gallery_theta0=30.0,
             runs.append((path, *read_run(path)))
         else:
             raise ValueError(f"no such file or directory: {path!r}")
-    os.makedirs(out, exist_ok=True)
-    written = {}
+    return sweeps, runs
 
-    def save(name, fig):
-        path = save_figure(fig, os.path.join(out, f"{name}.png"), dpi=dpi)
-        written[name] = path
-        log(f"{name}: {path}")
 
+def _draw_sweep_figures(save, only, main, sweeps, gallery_theta0, stability_n, branch_n, log):
+    """Figs. 3, 4, 5, 7, 8, 9 and the seed distributions, each through ``save(name, fig)``;
+    ``branch_n`` None: Fig. 8 without the steady branch."""
     reference = (pd.concat([f for _, f in sweeps["reference"]], ignore_index=True)
                  if sweeps["reference"] else None)
     if "stability" in only:
@@ -141,10 +165,9 @@ def write_figures(sweep_dir, others=(), out=".", only=None, gallery_theta0=30.0,
     if "q_tilt" in only:
         save("fig7_q_tilt", q_and_tilt(main, reference=reference))
     if "aspect" in only:
-        steady, note = ((None, "steady branch not requested") if not branch
-                        else load_branch(branch_n))
-        if note:
-            log(note)
+        if branch_n is None:
+            log("steady branch not requested")
+        steady = None if branch_n is None else steady_branch(n=branch_n, q_max=25.0)
         save("fig8_aspect", aspect_ratio(main, steady, reference=reference, q_max=40.0))
     if "phase_n" in only and sweeps["grid"]:
         frames = sorted([f for _, f in sweeps["grid"]], key=lambda f: int(f["n"].min()))
@@ -152,6 +175,10 @@ def write_figures(sweep_dir, others=(), out=".", only=None, gallery_theta0=30.0,
     if "seeds" in only and sweeps["seeds"]:
         frames = [f for _, f in sweeps["seeds"]]
         save("seed_distributions", seed_distributions(frames, [sweep_label(f) for f in frames]))
+
+
+def _draw_run_figures(save, only, runs):
+    """Fig. 6 (one per run, or one of all runs) and Fig. 1 (per run) through ``save``."""
     if "evolution" in only and len(runs) > 1:
         save("fig6_evolution", evolution_rows([t for _, t, _ in runs],
                                               [run_title(s) for *_, s in runs]))
@@ -162,4 +189,3 @@ def write_figures(sweep_dir, others=(), out=".", only=None, gallery_theta0=30.0,
         if "tension" in only:
             save(f"fig1_tension_{stem}",
                  tension_figure(trajectory, title=run_title(summary) + "\n"))
-    return written

@@ -57,6 +57,10 @@ def integrate(method, problem, y0, t0, t_end, t_out, options, y_out):
     (``control.monitor``; worst[2:] is the monitor's state) (for a loop: the worst transient relative length
     error and spectral tail).  Status REFINE (``options.resolution_tol`` exceeded) ends
     the run at the step that outgrew the truncation.
+
+    Longer than a screen: a Numba entry whose loop is the one adaptive loop of every
+    method (start, attempt, accept or reject, output, monitors); its steps are already
+    the method's generics, and what is left is their order, read best in one place.
     """
     counts = np.zeros(len(COUNTS), dtype=np.int64)
     ny = y0.shape[0]

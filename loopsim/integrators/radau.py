@@ -33,7 +33,6 @@ right after a rejection (Hairer).  The error weights atol + rtol |y_i| are
 floored at the rounding error a step carries (ROUNDOFF_FLOOR): with a tiny
 atol, components near zero otherwise ask the Newton iteration and the
 estimate for accuracy below rounding, and the run stalls in Newton failures.
-:func:`fd_jacobian` is a forward-difference fallback for new models.
 Everything writes into caller-owned arrays.
 """
 import collections
@@ -44,7 +43,7 @@ from ..jit import kernel
 from ..models import jacobian, rhs
 from .base import advance, attempt, dense_output, implements, start, statistics
 from .control import EPS, MAX_FACTOR, MIN_FACTOR, SAFETY, rms_norm
-from ..linalg import PIVOT_DTYPE, copy_into, lu_factor, lu_solve
+from ..linalg import PIVOT_DTYPE, lu_factor, lu_solve
 
 _S6 = np.sqrt(6.0)
 C = np.array([(4.0 - _S6) / 10.0, (4.0 + _S6) / 10.0, 1.0])
@@ -145,21 +144,6 @@ def extrapolated_guess(q, ratio, z):
 
 
 # ---- Newton matrices, iteration and error estimate -----------------------
-@kernel
-def fd_jacobian(problem, y, f, jac, y_work, f_work):
-    """jac[:, j] = (F(y + δ_j e_j) − F(y)) / δ_j, δ_j = √eps · max(1, |y_j|)."""
-    root_eps = np.sqrt(EPS)
-    copy_into(y_work, y)
-    for j in range(y.shape[0]):
-        delta = root_eps * max(1.0, abs(y[j]))
-        y_work[j] = y[j] + delta
-        delta = y_work[j] - y[j]  # the step actually representable
-        rhs(problem, y_work, f_work)
-        for i in range(y.shape[0]):
-            jac[i, j] = (f_work[i] - f[i]) / delta
-        y_work[j] = y[j]
-
-
 @kernel
 def newton_matrices(jac, h, lu_real, piv_real, lu_complex, piv_complex):
     """Factorise μ_r/h − J and μ_c/h − J."""

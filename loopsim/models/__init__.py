@@ -14,15 +14,15 @@ import functools
 import numpy as np
 
 from .. import validation
-from ..config import MAX_SLENDERNESS, MODEL_CHOICES
+from ..defaults import MAX_SLENDERNESS, MODEL_CHOICES
 from ..jit import entry
-from . import local_sbt, nonlocal_circle, nonlocal_sbt, riccati  # noqa: F401 - registers them
+from . import local_sbt, nonlocal_closed_form, nonlocal_sbt, riccati  # noqa: F401 - registers them
 from .base import (
     auxiliary, for_case, implements, jacobian, monitored_errors, rhs, steady_invariants,
 )
 
 __all__ = ["Model", "LOCAL", "choose", "highest_order", "check_order", "make_problem",
-           "case_constants", "case_parameters", "difference_jacobian", "rhs", "jacobian", "monitored_errors",
+           "case_constants", "case_parameters", "rhs", "jacobian", "monitored_errors",
            "steady_invariants",
            "auxiliary",
            "for_case", "implements", "evaluate", "evaluate_jacobian", "local_sbt", "nonlocal_sbt",
@@ -44,31 +44,7 @@ def evaluate_jacobian(problem, y, jac):
     jacobian(problem, y, f, jac, np.empty_like(y), np.empty_like(y))
 
 
-#: Relative step of :func:`difference_jacobian`: the cube root of the machine epsilon.
-CENTRAL_STEP = float(np.finfo(float).eps ** (1.0 / 3.0))
-
-
-def difference_jacobian(problem, y, step=CENTRAL_STEP):
-    """∂F/∂y by central differences: column j is [F(y + h e_j) − F(y − h e_j)] / 2h with
-    h = step max(1, |y_j|) (truncation error O(h²), rounding O(ε/h): about 1e-10 relative
-    at the default step).  For analyses of a model without an exact Jacobian."""
-    y = np.array(y, dtype=float)
-    size = y.size
-    jac = np.empty((size, size))
-    plus, minus, aux = np.empty(size), np.empty(size), np.empty(size // 3)
-    for j in range(size):
-        h = step * max(1.0, abs(y[j]))
-        saved = y[j]
-        y[j] = saved + h
-        evaluate(problem, y, plus, aux)
-        y[j] = saved - h
-        evaluate(problem, y, minus, aux)
-        y[j] = saved
-        jac[:, j] = (plus - minus) / (2.0 * h)
-    return jac
-
-
-#: The loop's model as a user chooses it: ``name`` one of ``config.MODEL_CHOICES``,
+#: The loop's model as a user chooses it: ``name`` one of ``defaults.MODEL_CHOICES``,
 #: ``slenderness`` ε = a/L for "nonlocal" (None for "local").
 Model = collections.namedtuple("Model", "name slenderness")
 #: The default: the paper's local slender-body theory.
@@ -77,7 +53,7 @@ LOCAL = Model("local", None)
 
 def choose(name="local", slenderness=None):
     """The :class:`Model` of a user's choice, checked: one-line ValueErrors naming the value
-    (the nonlocal model needs a slenderness in (0, ``config.MAX_SLENDERNESS``]; the local
+    (the nonlocal model needs a slenderness in (0, ``defaults.MAX_SLENDERNESS``]; the local
     one takes none)."""
     name = validation.check_choice("model", name, MODEL_CHOICES)
     if name == "local":
@@ -96,10 +72,10 @@ def choose(name="local", slenderness=None):
 def highest_order(model):
     """The highest truncation order ``model`` can run at (None: no limit below
     ``validation.MAX_N``): for the nonlocal model, one below the first mode its operator is not positive at on the circle
-    (``nonlocal_circle.first_nonpositive_mode``: ε = 1e-2 gives n ≤ 10, 1e-3 n ≤ 108)."""
+    (``nonlocal_closed_form.first_nonpositive_mode``: ε = 1e-2 gives n ≤ 10, 1e-3 n ≤ 108)."""
     if model.name == "local":
         return None
-    first = nonlocal_circle.first_nonpositive_mode(model.slenderness, validation.MAX_N + 1)
+    first = nonlocal_closed_form.first_nonpositive_mode(model.slenderness, validation.MAX_N + 1)
     return None if first is None else first - 1
 
 

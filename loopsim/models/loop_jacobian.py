@@ -40,6 +40,12 @@ def mobility_jacobian(w, isotropic, along, nonlocal_share, weight, direction, po
         δT = −(AᵀA)⁻¹ [Aᵀ δε + δAᵀ r],   δu = F(δm + m_T δT),
 
     with ε = A T + b, r = ε(T) the residual and m_T the tension columns of m.
+
+    Longer than a screen: one pass of the chain rule over temporaries every step shares
+    (f, m, P1 m, the tension columns, their grids); the nonlocal parts are already kernels
+    of their own (below).  Split further, each step would take a dozen work arrays, and
+    a kernel split changes what LLVM inlines: the bit-identical bench counts this
+    refactoring is held to (benchmarks/bench_step_control.py) would need a new check.
     """
     m, k = ops.m, ops.S0.shape[1]
     d = 3 * k

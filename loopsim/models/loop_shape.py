@@ -2,7 +2,7 @@
 error, its spectral tail and the shape invariants that define a steady state."""
 import numpy as np
 
-from ..config import DEFORMATION_FLOOR
+from ..defaults import DEFORMATION_FLOOR
 from ..jit import kernel
 from ..linalg import copy_into
 
@@ -49,7 +49,7 @@ def spectral_tail(x):
     """Share of the loop's deformation carried by its top modes k ≥ max(2, n − 1), x (3, 2n+1):
 
         sqrt(Σ_{k ≥ max(2, n-1)} E_k / (Σ_{k ≥ 2} E_k + φ² Σ_{k ≥ 1} E_k)),
-        E_k = ½ Σ_xyz (a_k² + b_k²),  φ = ``config.DEFORMATION_FLOOR``
+        E_k = ½ Σ_xyz (a_k² + b_k²),  φ = ``defaults.DEFORMATION_FLOOR``
 
     (the same as ``diagnostics.spectral_tail``; 0 for a point).  Modes k ≥ 2 are what
     deforms a circle; relative to them, the tail measures what the truncation does to

@@ -201,16 +201,6 @@ def K_operator(x, f, quadrature_points=None, *, f_on_grid=False, order=None,
     return _output(_apply_k(weight, direction, _force_grid(f, m, f_on_grid)), order)
 
 
-def Lambda_operator(x, f, eps, quadrature_points=None, *, f_on_grid=False, order=None):
-    """Λ[f] = [(c+1) I + (c-3) x'x'] · f, c = -2 log ε (grid values or coefficients)."""
-    x, n = _shape(x)
-    c = slenderness_constant(eps)
-    m = _grid_size(n, f, f_on_grid, quadrature_points)
-    fg = _force_grid(f, m, f_on_grid)
-    t = x @ spectral.synthesis_matrix(n, m, 1).T
-    return _output((c + 1.0) * fg + (c - 3.0) * t * np.sum(t * fg, axis=0), order)
-
-
 def nonlocal_velocity(x, f, eps, quadrature_points=None, *, f_on_grid=False, order=None,
                       arclength_tol=ARCLENGTH_TOL):
     """u = (1/c) { Λ[f] + K[f] } (module doc), c = -2 log ε, ε = a/L.

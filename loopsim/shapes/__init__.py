@@ -5,7 +5,7 @@
 * ``loading``: point files and earlier results, and :func:`start_shape`, the one
   resolver of a run's start used by ``simulate``, sweeps and the CLI.
 """
-from .circle import (
+from .tilted_circle import (
     default_perturbation, inclined_circle, initial_shape, perturb, perturbation_field,
 )
 from .curvefit import check_points, fit_points

@@ -27,9 +27,9 @@ import os
 
 import numpy as np
 
-from .. import diagnostics, io, spectral, validation
-from ..config import DEFAULT_N, INITIAL_CONTENT_TOL
-from .circle import default_perturbation, initial_shape, perturb
+from .. import diagnostics, spectral, storage, validation
+from ..defaults import DEFAULT_N, INITIAL_CONTENT_TOL
+from .tilted_circle import default_perturbation, initial_shape, perturb
 from .curvefit import fit_points
 
 #: RMS relative amplitude of the top modes above which a shape is flagged unresolved.
@@ -60,7 +60,7 @@ def read_points(path):
             import pyarrow.parquet as pq
 
             rows = pq.ParquetFile(path).metadata.num_rows
-            frame = None if rows > limit else io.read_table_checked(path).to_pandas()
+            frame = None if rows > limit else storage.read_table_checked(path).to_pandas()
         else:
             frame = pd.read_csv(path, nrows=limit + 1)
             rows = len(frame)
@@ -101,7 +101,7 @@ def content_order(fine, tol=INITIAL_CONTENT_TOL):
 
 def auto_start_order(initial, case_id=None, low=DEFAULT_N, high=None):
     """The order a run with ``n="auto"`` starts a given shape at: for a point file, the
-    order its content needs (``info["content_order"]``, :data:`config.INITIAL_CONTENT_TOL`)
+    order its content needs (``info["content_order"]``, :data:`defaults.INITIAL_CONTENT_TOL`)
     but not below ``low`` (the ladder's usual start) nor above ``high`` (its top); None for
     coefficients and results, which start at their stored order (exact)."""
     if not isinstance(initial, (str, os.PathLike)):
@@ -183,7 +183,7 @@ def _results_shape(path, case_id):
     import pyarrow.parquet as pq
 
     if os.path.isdir(path):
-        return _results_case(io.read_results(path), path, case_id)
+        return _results_case(storage.read_results(path), path, case_id)
     validation.check_input_file("initial shape file", path, validation.MAX_RESULTS_FILE_BYTES)
     if not _is_parquet(path):
         return None
@@ -193,10 +193,11 @@ def _results_shape(path, case_id):
         raise ValueError(f"cannot read initial shape file {path!r}: {_first_line(exc)}") from None
     names = set(schema.names)
     if {"case_id", "x_final"} <= names:  # one chunk file of a sweep
-        return _results_case(io.read_table_checked(path).to_pandas(), path, case_id)
+        return _results_case(storage.read_table_checked(path).to_pandas(), path, case_id)
     if not {"t", "x"} <= names:
         return None
-    table = io.read_table_checked(path).select([c for c in ("case_id", "t", "x") if c in names])
+    table = storage.read_table_checked(path).select(
+        [c for c in ("case_id", "t", "x") if c in names])
     rows = table.to_pandas()
     if "case_id" in names:  # a sweep's snapshots file
         ids = sorted(set(rows["case_id"]))
@@ -211,7 +212,7 @@ def _results_shape(path, case_id):
         if case_id not in (None, 0):
             raise ValueError(f"case id {case_id} is not in the results {path!r} "
                              "(a single run: case 0)")
-        summary = io.read_metadata(path).get("summary", {})
+        summary = storage.read_metadata(path).get("summary", {})
         if not isinstance(summary, dict):
             summary = {}
     last = rows.iloc[int(np.argmax(rows["t"].to_numpy()))]
@@ -304,11 +305,11 @@ def start_shape(theta0_deg=None, n=None, perturbation=None, seed=0, initial=None
     """The start of a run, resolved in one place for ``simulate``, sweeps and the CLI.
 
     Without ``initial``: the circle tilted by ``theta0_deg`` (required) with the
-    seeded perturbation (``circle.initial_shape``), n defaulting to DEFAULT_N.
+    seeded perturbation (``tilted_circle.initial_shape``), n defaulting to DEFAULT_N.
     With ``initial`` (coefficients, or a path: :func:`load_initial`):
     ``theta0_deg`` must be None and becomes the shape's measured tilt, n
     defaults to the shape's order, and the perturbation (in the shape's own
-    frame, ``circle.perturb``) defaults to 0.
+    frame, ``tilted_circle.perturb``) defaults to 0.
 
     Returns (x0 (3, 2n+1), theta0_deg, n, perturbation, info); info is None for
     the circle, else the shape's diagnostics.

@@ -10,4 +10,4 @@
   continued in q, and their in-plane and out-of-plane stability;
 * ``roots``: the scan-and-refine root finder they share.
 """
-from . import branch, circle, onset, paper  # noqa: F401
+from . import branch, full_linear, onset, paper  # noqa: F401

@@ -8,7 +8,7 @@ tangent t the null vector of [∂H/∂u, ∂H/∂q] (norm ⟨x, x⟩ + q²), pre
 y + h t, corrector Newton on H = 0 plus ⟨t, y - y_pred⟩ = 0; a corrector that
 lands far from the prediction or turns the tangent sharply (e.g. back onto the
 circle) is rejected and the step halved.  The branch leaves the translating
-circle at the in-plane threshold q_c (``circle.critical_q``, 8.9001
+circle at the in-plane threshold q_c (``full_linear.critical_q``, 8.9001
 converged): the first corrector uses the hyperplane ⟨φ, x - x_circle⟩ = h, φ
 the mirror-symmetric null vector of ∂H/∂u at the circle (the critical
 eigenspace is double: the mirror-symmetric and the antisymmetric flattening);
@@ -36,16 +36,17 @@ intermediate q).
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 
 import numpy as np
 from scipy.optimize import brentq
 
 from .. import spectral, validation
-from ..config import DEFAULT_W
+from ..defaults import DEFAULT_W
 from ..models import local_sbt
 from ..shapes import inclined_circle
-from .circle import critical_q, l2_weights
+from .full_linear import critical_q, l2_weights
 # The steady equations, re-exported: ``stability.branch`` has always offered them.
 from .steady import (  # noqa: F401
     NORMAL, PLANE, SteadyShape, mirror_symmetric_index, newton, planar_state, plane_index,
@@ -57,8 +58,8 @@ __all__ = [
     "PLANE", "NORMAL", "steady_residual", "steady_jacobian", "SteadyShape", "solve_steady",
     "planar_state", "tilt_shape", "to_plane", "mirror_symmetric_index",
     "neutral_modes", "stability", "Branch", "continue_branch", "steady_branch",
-    "q_loss_out_of_plane", "branch_rows", "branch_summary", "ROW_FIELDS", "upper_half",
-    "out_of_plane_loss", "out_of_plane_loss_near",
+    "q_loss_out_of_plane", "branch_rows", "branch_summary", "ROW_FIELDS", "upper_half", "steady_branch_to",
+    "out_of_plane_loss_near",
 ]
 
 #: First corrector's distance from the circle along φ (L² amplitude), and the
@@ -162,7 +163,7 @@ class Branch:
     ``q_bifurcation``: q at zero amplitude, measured on the branch: the even part
     (q(h) + q(-h)) / 2 at h = START_AMPLITUDE and 2h off the circle along φ,
     Richardson-extrapolated (error O(h⁴)); ``q_circle``: the circle's in-plane
-    threshold (``circle.critical_q``); ``shapes``: the steady shapes in arclength order,
+    threshold (``full_linear.critical_q``); ``shapes``: the steady shapes in arclength order,
     the circle at q_c first, then the side with ⟨φ, x - x_circle⟩ > 0 (``side`` +1) or
     < 0 (-1), as asked; ``null_vector``: φ (2, K) in [X, Z].
     """
@@ -349,15 +350,6 @@ def upper_half(n, q_max, w=DEFAULT_W, step_max=None):
     raise ValueError(f"no half of the branch leaves towards q > q_c at n = {n}")
 
 
-def out_of_plane_loss(n, q_max=45.0, w=DEFAULT_W, step_max=0.5):
-    """q_loss_out_of_plane at truncation n: the upper half continued to q_max with steps up
-    to ``step_max`` (the crossing itself is refined by bisection, so coarse steps only
-    risk missing a crossing and recrossing between two points); None if none."""
-    half = upper_half(n, q_max, w, step_max)
-    rows = [_row(shape, 1) for shape in half.shapes]
-    return q_loss_out_of_plane(rows, half.shapes)
-
-
 def steady_branch(n=12, q_max=25.0, w=DEFAULT_W, q_min=None):
     """The branch of steady in-plane shapes as a pandas DataFrame (columns ``ROW_FIELDS``),
     for figures (the paper's Fig. 8: terminal aspect ratio against q, stable parts solid).
@@ -371,6 +363,13 @@ def steady_branch(n=12, q_max=25.0, w=DEFAULT_W, q_min=None):
     frame = pd.DataFrame(result["branch"], columns=list(ROW_FIELDS))
     frame.attrs.update({key: value for key, value in result.items() if key != "branch"})
     return frame
+
+
+@functools.lru_cache(maxsize=4)
+def steady_branch_to(q_max):
+    """The local model's steady branch at n = 12 up to ``q_max`` (:func:`steady_branch`),
+    computed once per process for each ``q_max``."""
+    return steady_branch(n=12, q_max=q_max)
 
 
 def branch_summary(n=12, q_max=25.0, w=DEFAULT_W, q_min=None):

@@ -1,6 +1,6 @@
 """When do loops released near the circle become visibly in-plane or 3D: onset predictions.
 
-From the circle's growth rates (``stability.circle``) and the linear gains of
+From the circle's growth rates (``stability.full_linear``) and the linear gains of
 the sweep's observables (aspect ratio, tilt); see :func:`regime_onsets`.
 """
 import math
@@ -9,9 +9,9 @@ import numpy as np
 from scipy.linalg import eig
 
 from .. import diagnostics, models, validation
-from ..config import DEFAULT_W
+from ..defaults import DEFAULT_W
 from ..shapes import inclined_circle, initial_shape
-from .circle import (
+from .full_linear import (
     SECTORS, check_sector, critical_q, full_spectrum, l2_weights,
     linearise_circle, neutral_modes, sigma,
 )

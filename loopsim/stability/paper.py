@@ -11,7 +11,7 @@ The paper's ∂² term has the wrong sign: its T0 = 1 + q cos s should be
 
     L = -∂⁴ - ∂² + q (sin s ∂ + cos s ∂²)
 
-reproduces the out-of-plane block of the full Jacobian (``stability.circle``).
+reproduces the out-of-plane block of the full Jacobian (``stability.full_linear``).
 Both are built here from one formula with ``corrected`` choosing the sign.
 
 Product-to-sum formulas give, for k ≥ 1 and the sign σ of ∂² (+1 paper, -1

@@ -27,7 +27,7 @@ H(u; q) = 0 (2K + 3 rows):
     ⟨x_ref', x - x_ref⟩ = 0                                           (arc-length shift)
 
 with e_0 the mean coefficient, D = ``spectral.derivative_matrix``, ⟨·,·⟩ the
-L² product of the coefficient layout (``circle.l2_weights``) and x_ref the
+L² product of the coefficient layout (``full_linear.l2_weights``) and x_ref the
 previous point of the branch.  The rigid motions left by gravity along -z are
 exactly these: the translations and the shift; an in-plane rotation changes
 the angle to gravity (no phase condition), and the two rotations out of the
@@ -47,9 +47,9 @@ import math
 import numpy as np
 
 from .. import diagnostics, models, spectral
-from ..config import DEFAULT_W
+from ..defaults import DEFAULT_W
 from ..models import local_sbt
-from .circle import l2_weights
+from .full_linear import l2_weights
 
 __all__ = [
     "PLANE", "NORMAL", "planar_state", "steady_velocity", "velocity_jacobian", "plane_index",

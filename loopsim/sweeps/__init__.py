@@ -11,7 +11,7 @@ renamed into place.  A resume computes the positions no file holds, so a
 changed chunk size, a piece cut short by a signal and job-array shards all
 fit.  Cases run on a work queue of this machine's threads or as Dask tasks.  No numerics
 here: integration is ``batch``, start shapes ``shapes``, summaries ``api``,
-tables ``io``.
+tables ``storage``.
 
 One module per job, each layer importing only those above it:
 
@@ -20,7 +20,7 @@ One module per job, each layer importing only those above it:
 * ``directory``: the sweep directory made, checked, repaired and written into;
 * ``runner``: a piece's cases integrated into rows (:func:`run_chunk`, :func:`run_piece`);
 * ``progress``: the progress line and its cost-weighted ETA;
-* ``stopping``: SIGINT / SIGTERM as a stop flag (:class:`SweepInterrupted`);
+* ``signals``: SIGINT / SIGTERM as a stop flag (:class:`SweepInterrupted`);
 * ``local``, ``dask_backend``: the backends (a work queue of threads, Dask tasks);
 * ``orchestrate``: :func:`run_sweep` and :func:`sweep`, the top level;
 * ``rerun``: reruns of the failed cases (:func:`rerun_failed`);
@@ -42,7 +42,7 @@ from .progress import AUTO_COST_EXPONENT, Progress, case_weight
 from .rerun import config_from_dict, rerun_failed
 from .runner import case_ladder, case_method, run_chunk, run_piece
 from .seeds_auto import run_seeds_auto
-from .stopping import SweepInterrupted, in_background, stop_event, stop_on_signals
+from .signals import SweepInterrupted, in_background, stop_event, stop_on_signals
 
 __all__ = [
     "AUTO_COST_EXPONENT", "CASE_COLUMNS", "CASE_OVERRIDES", "FIELD_NOTES", "Progress",

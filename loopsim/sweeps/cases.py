@@ -10,8 +10,8 @@ import re
 import numpy as np
 import pandas as pd
 
-from .. import integrators, io, models, refinement, shapes, validation
-from ..config import (
+from .. import integrators, models, refinement, shapes, storage, validation
+from ..defaults import (
     DEFAULT_ATOL, DEFAULT_CHUNK_SIZE, DEFAULT_LENGTH_TOL, DEFAULT_MAX_STEPS, DEFAULT_N_MAX,
     MODEL_CHOICES,
     DEFAULT_PERTURBATION, DEFAULT_RTOL, DEFAULT_STEADY_INTERVAL, DEFAULT_STEADY_TOL,
@@ -197,7 +197,7 @@ def read_cases_file(path, perturbation=DEFAULT_PERTURBATION, n=6, auto_top=None)
             rows = parquet.metadata.num_rows
             names = parquet.schema_arrow.names
             # checked as loopsim's own files are (a table loopsim wrote carries checksums)
-            frame = None if rows > limit else io.read_table_checked(path).to_pandas()
+            frame = None if rows > limit else storage.read_table_checked(path).to_pandas()
         else:
             frame = pd.read_csv(path, nrows=limit + 1)
             rows, names = len(frame), list(frame.columns)

@@ -1,9 +1,9 @@
 """Where the cases go: the fixed order of positions, the chunks of a sweep and the pieces
 still to compute (a function of the configuration and the files already there)."""
-from .. import io
+from .. import storage
 
 
-case_order = io.case_order
+case_order = storage.case_order
 
 
 def canonical_chunks(config):

@@ -4,8 +4,8 @@ import os
 
 import numpy as np
 
-from .. import io, seeding, validation
-from ..config import (
+from .. import seeds_auto_rule, storage, validation
+from ..defaults import (
     DEFAULT_ATOL, DEFAULT_AUTO_CHUNK_SIZE, DEFAULT_CHUNK_SIZE, DEFAULT_LENGTH_TOL,
     DEFAULT_MAX_STEPS, DEFAULT_N, DEFAULT_N_MAX, DEFAULT_PERTURBATION, DEFAULT_RTOL,
     DEFAULT_STEADY_INTERVAL, DEFAULT_STEADY_TOL, DEFAULT_T_END, DEFAULT_TAIL_TOL, DEFAULT_W,
@@ -19,7 +19,7 @@ from .directory import prepare_directory
 from .local import run_local
 from .progress import Progress, case_weight
 from .seeds_auto import run_seeds_auto
-from .stopping import SweepInterrupted, stop_event, stop_on_signals
+from .signals import SweepInterrupted, stop_event, stop_on_signals
 
 
 def run_sweep(config, out, threads=None, quiet=False, command_line=None, *, scheduler=None,
@@ -67,7 +67,7 @@ def run_sweep(config, out, threads=None, quiet=False, command_line=None, *, sche
         client, cluster = dask_client(scheduler, workers)
     try:
         fingerprint = prepare_directory(out, config, command_line or [])
-        covered = io.chunk_files(out)
+        covered = storage.chunk_files(out)
         pieces = pending_pieces(config, covered, shard)
         mine = covered_ids(config, [(c.start, c.stop)
                                      for k, c in enumerate(canonical_chunks(config))
@@ -98,7 +98,7 @@ def run_sweep(config, out, threads=None, quiet=False, command_line=None, *, sche
     progress.close()
     if stop.is_set():
         raise SweepInterrupted(stop.signum, out, progress.done, progress.total)
-    return io.read_results(out)
+    return storage.read_results(out)
 
 
 def sweep(g0, theta0_deg, out, *, n="auto", seeds=1, method=None, t_end=DEFAULT_T_END,
@@ -127,14 +127,14 @@ def sweep(g0, theta0_deg, out, *, n="auto", seeds=1, method=None, t_end=DEFAULT_
         The sweep directory.
     n : int, sequence of int or "auto", default "auto"
         Truncation orders (1..128), or "auto": every case starts at n = 6 and is
-        restarted from t = 0 at the next order of ``config.AUTO_ORDERS`` (up to ``n_max``)
+        restarted from t = 0 at the next order of ``defaults.AUTO_ORDERS`` (up to ``n_max``)
         whenever its spectral tail passes ``tail_tol``.  The paper's scheme is
         ``n=6, method="rkf45"``.
     seeds : int or "auto", default 1
         Seeds 0..seeds-1 per grid point, or "auto": rounds of seeds per cell until its
         answer is sharp (``p_halfwidth``, ``tilt_halfwidth``), deterministic, or at
         ``max_seeds`` (docs/distributions.md); the rows then get a ``round`` column and
-        the stop table is ``loopsim.io.read_stop_table(out)``.
+        the stop table is ``loopsim.storage.read_stop_table(out)``.
     method : {"rkf45", "radau5", "auto"} or None, default None
         The integrator; None means "rkf45" (the paper's scheme) at a fixed n and "auto"
         (chosen per case) with ``n="auto"``.
@@ -182,7 +182,7 @@ def sweep(g0, theta0_deg, out, *, n="auto", seeds=1, method=None, t_end=DEFAULT_
         Cases per result file; None: 32, or 4 with ``n="auto"``.
     p_halfwidth, tilt_halfwidth, min_seeds, max_seeds, check_seeds : float, int or None, default None
         With ``seeds="auto"`` only: its targets (a probability; degrees; counts); None:
-        the values of ``loopsim.config.SEED_TARGETS`` (0.15, 2.5, 4, 64, 8).
+        the values of ``loopsim.defaults.SEED_TARGETS`` (0.15, 2.5, 4, 64, 8).
     quiet : bool, default True
         No progress line.
     threads : int or None, default None
@@ -248,7 +248,7 @@ def sweep(g0, theta0_deg, out, *, n="auto", seeds=1, method=None, t_end=DEFAULT_
                    scheduler=scheduler, local_cluster=local_cluster, workers=workers)
     if seeds_auto:
         rows, _ = run_seeds_auto(
-            config, os.fspath(out), seeding.SeedTargets(**targets),
+            config, os.fspath(out), seeds_auto_rule.SeedTargets(**targets),
             run_round=lambda round_config, directory, weights: run_sweep(
                 round_config, directory, weights=weights, **backend),
             command_line=backend["command_line"])

@@ -5,7 +5,7 @@ import os
 
 import pyarrow as pa
 
-from .. import io, refinement, validation
+from .. import refinement, storage, validation
 from ..outcomes import Thresholds
 from .cases import SweepConfig
 from .orchestrate import run_sweep
@@ -34,12 +34,12 @@ def rerun_failed(out, method, rtol, atol, **backend):
         validation.check_choice("--method", method, refinement.METHOD_CHOICES)
     validation.check_real("--rtol", rtol, low=0.0, low_open=True)  # before anything is
     validation.check_real("--atol", atol, low=0.0)  # recorded: a refused rerun leaves no trace
-    if os.path.isdir(out) and io.is_seeds_auto(out):
+    if os.path.isdir(out) and storage.is_seeds_auto(out):
         return _rerun_rounds(out, method, rtol, atol, **backend)
-    stored = io.read_sweep_file(out) if os.path.isdir(out) else None
+    stored = storage.read_sweep_file(out) if os.path.isdir(out) else None
     if stored is None:
-        raise ValueError(f"no sweep at {out!r} (no {io.SWEEP_FILE}) to rerun failed cases of")
-    io.check_layout(out)
+        raise ValueError(f"no sweep at {out!r} (no {storage.SWEEP_FILE}) to rerun failed cases of")
+    storage.check_layout(out)
     base = config_from_dict(stored["config"])
     settings = dict(method=method or base.method, rtol=rtol, atol=atol)
     reruns = stored.get("reruns", [])
@@ -48,7 +48,7 @@ def rerun_failed(out, method, rtol, atol, **backend):
         raise ValueError(f"rerun {open_attempt['attempt']} of {out!r} is unfinished with "
                          f"{open_attempt['settings']}: finish it first (same options)")
     if open_attempt is None:
-        frame = io.read_results(out)
+        frame = storage.read_results(out)
         failed = sorted(int(i) for i in frame.loc[frame["status"] != "ok", "case_id"])
         if not failed:
             return frame, 0
@@ -61,17 +61,17 @@ def rerun_failed(out, method, rtol, atol, **backend):
         open_attempt = dict(attempt=len(reruns) + 1, settings=settings, case_ids=failed,
                             merged=False)
         stored["reruns"] = reruns + [open_attempt]
-        io.write_json_atomically(stored, os.path.join(out, io.SWEEP_FILE))
+        storage.write_json_atomically(stored, os.path.join(out, storage.SWEEP_FILE))
     ids = open_attempt["case_ids"]
-    directory = os.path.join(out, io.RERUN_DIR, str(open_attempt["attempt"]))
+    directory = os.path.join(out, storage.RERUN_DIR, str(open_attempt["attempt"]))
     config = dataclasses.replace(base, cases=[base.cases[i] for i in ids], snapshots_for=[],
                                  **settings)
     rerun = run_sweep(config, directory, **backend)
     _merge_rerun(out, stored["fingerprint"], directory, open_attempt["attempt"],
                  rerun.assign(case_id=[ids[i] for i in rerun["case_id"]]))
     open_attempt["merged"] = True
-    io.write_json_atomically(stored, os.path.join(out, io.SWEEP_FILE))
-    return io.read_results(out), len(ids)
+    storage.write_json_atomically(stored, os.path.join(out, storage.SWEEP_FILE))
+    return storage.read_results(out), len(ids)
 
 
 def _rerun_rounds(out, method, rtol, atol, **backend):
@@ -79,20 +79,20 @@ def _rerun_rounds(out, method, rtol, atol, **backend):
     cases is a sweep of its own, rerun in place.  The stop table stays as written (why
     each cell stopped, with the rows it had then); ``read_results`` and ``summary`` read
     the rows as they are now."""
-    if not os.path.isfile(os.path.join(out, io.STOPS_FILE)):
+    if not os.path.isfile(os.path.join(out, storage.STOPS_FILE)):
         raise ValueError(f"the --seeds auto sweep in {out!r} has not finished: re-run its "
                          "command first (its later rounds are planned from these rows)")
-    rows = io.read_results(out)  # every round checked before any rerun
+    rows = storage.read_results(out)  # every round checked before any rerun
     reran = 0
     for index in sorted(rows.loc[rows["status"] != "ok", "round"].unique()):
-        directory = io.round_directory(out, int(index))
-        stored = io.read_sweep_file(directory)
+        directory = storage.round_directory(out, int(index))
+        stored = storage.read_sweep_file(directory)
         last = (stored.get("reruns") or [None])[-1]
         settings = dict(method=method or stored["config"]["method"], rtol=rtol, atol=atol)
         if last is not None and last["merged"] and last["settings"] == settings:
             continue  # rerun with these settings by an earlier, interrupted call
         reran += rerun_failed(directory, method, rtol, atol, **backend)[1]
-    return io.read_results(out), reran
+    return storage.read_results(out), reran
 
 
 def _merge_rerun(out, fingerprint, directory, attempt, rows):
@@ -101,22 +101,22 @@ def _merge_rerun(out, fingerprint, directory, attempt, rows):
     short by a kill resumes)."""
     replaced = os.path.join(directory, "replaced")
     os.makedirs(replaced, exist_ok=True)
-    new = pa.Table.from_pandas(rows, schema=io.RESULT_SCHEMA, preserve_index=False)
+    new = pa.Table.from_pandas(rows, schema=storage.RESULT_SCHEMA, preserve_index=False)
     by_id = set(rows["case_id"])
-    for (start, stop), path in sorted(io.chunk_files(out).items()):
-        meta = io.read_metadata(path)
+    for (start, stop), path in sorted(storage.chunk_files(out).items()):
+        meta = storage.read_metadata(path)
         if attempt in meta.get("reruns", []):
             continue
-        written = io.read_table_checked(path, io.requires_hash(io.read_sweep_file(out)))
-        table = io.result_table(written)
+        written = storage.read_table_checked(path, storage.requires_hash(storage.read_sweep_file(out)))
+        table = storage.result_table(written)
         mask = [i in by_id for i in table.column("case_id").to_pylist()]
         if not any(mask):
             continue
-        io.write_table_atomically(written, os.path.join(replaced, os.path.basename(path)))
+        storage.write_table_atomically(written, os.path.join(replaced, os.path.basename(path)))
         keep = table.filter(pa.array([not m for m in mask]))
         ids = set(table.column("case_id").to_pylist())
         fresh = new.filter(pa.array([i in ids for i in new.column("case_id").to_pylist()]))
         merged = pa.concat_tables([keep, fresh]).sort_by("case_id")
-        meta = io.provenance(sweep_fingerprint=fingerprint, positions=[start, stop],
+        meta = storage.provenance(sweep_fingerprint=fingerprint, positions=[start, stop],
                              reruns=meta.get("reruns", []) + [attempt])
-        io.write_table_atomically(merged.replace_schema_metadata(meta), path)
+        storage.write_table_atomically(merged.replace_schema_metadata(meta), path)

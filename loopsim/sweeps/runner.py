@@ -1,15 +1,16 @@
 """Running cases: one piece of positions integrated (in the batch kernel, or with
-snapshots through ``api.simulate``) into rows of ``io.RESULT_SCHEMA``."""
+snapshots through ``api.simulate``) into rows of ``storage.RESULT_SCHEMA``."""
 import functools
 import time
+import typing
 import warnings
 
 import numpy as np
 import pyarrow as pa
 
 from .. import (
-    _jitcache, api, columns, diagnostics, integrators, io, models, outcomes, refinement, shapes,
-    spectral,
+    _jitcache, api, columns, diagnostics, integrators, models, outcomes, refinement, shapes,
+    spectral, storage,
 )
 from .cases import case_model, case_option
 from .chunks import chunk_case_ids
@@ -99,18 +100,28 @@ def _traced_case(config, case_id):
                       [getattr(result, name) for name in integrators.COUNTS],
                       (result.length_error_max, result.tail_max), result.wall_s,
                       result.t_final, method, result.twin)
-    table = io.trajectory_table(result).replace_schema_metadata(None)
+    table = storage.trajectory_table(result).replace_schema_metadata(None)
     for name in ("x", "multiplier"):  # orders differ between cases: variable-length lists
         table = table.set_column(table.schema.get_field_index(name), name,
                                  table.column(name).cast(pa.list_(pa.float64())))
     table = table.add_column(0, "case_id", pa.array([case_id] * table.num_rows, pa.int64()))
-    return row, io.described(table, columns.TRAJECTORY_COLUMNS)
+    return row, storage.described(table, columns.TRAJECTORY_COLUMNS)
 
 
 def _group_order(item):
     """Groups of a chunk in a fixed order (the local model's slenderness None sorts first)."""
     (model, n, method, rtol, twin), _ = item
     return (model.name, model.slenderness or 0.0, n, method, rtol, twin)
+
+
+class GroupRun(typing.NamedTuple):
+    """One group of a chunk's cases run together in the batch kernel (:func:`run_chunk`)."""
+
+    members: list  #: the cases' ids
+    x0: list  #: their start shapes (3, 2n + 1)
+    method: str  #: the integrator's name
+    run: refinement.CasesRun  #: the runs
+    twins: object  #: the twins' ``refinement.CasesRun``, or None without twins
 
 
 def run_chunk(config, chunk, threads):
@@ -125,6 +136,28 @@ def run_chunk(config, chunk, threads):
     """
     ids = chunk_case_ids(config, chunk)
     traced = sorted(set(ids) & set(config.snapshots_for))
+    start = time.perf_counter()
+    compiled = _jitcache.compile_seconds()
+    groups = [_run_group(config, key, members)
+              for key, members in sorted(_groups(config, ids, traced).items(), key=_group_order)]
+    wall = time.perf_counter() - start - (_jitcache.compile_seconds() - compiled)
+    nfev = integrators.COUNTS.index("nfev")
+    total_rhs = sum(int(group.run.counts[:, nfev].sum())
+                    + (0 if group.twins is None else int(group.twins.counts[:, nfev].sum()))
+                    for group in groups) or 1
+    rows = {}
+    for group in groups:
+        rows.update(_group_rows(config, group, wall * threads, total_rhs))
+    snapshots = []
+    for case_id in traced:
+        rows[case_id], table = _traced_case(config, case_id)
+        snapshots.append(table)
+    table = pa.Table.from_pylist([rows[i] for i in sorted(rows)], schema=storage.RESULT_SCHEMA)
+    return table, (pa.concat_tables(snapshots) if snapshots else None)
+
+
+def _groups(config, ids, traced):
+    """{(model, n, method, rtol, twin): [case ids]} of the cases in ``ids`` not traced."""
     groups = {}
     for case_id in ids:
         if case_id not in traced:
@@ -132,53 +165,50 @@ def run_chunk(config, chunk, threads):
             key = (case_model(config, case), case["n"], case_method(config, case),
                    case_option(config, case, "rtol"), bool(case_option(config, case, "twin")))
             groups.setdefault(key, []).append(case_id)
-    start = time.perf_counter()
-    compiled = _jitcache.compile_seconds()
-    outputs = []
-    for (model, n, method, rtol, twin), members in sorted(groups.items(), key=_group_order):
-        cases = [config.cases[i] for i in members]
-        x0 = [shapes.start_shape(**_start(c))[0] for c in cases]
-        run = functools.partial(
-            refinement.integrate_cases, integrators.METHODS[method],
-            [models.case_parameters(model, c["g0"], config.w) for c in cases], x0,
-            [case_option(config, c, "t_end") for c in cases],
-            ladder=case_ladder(config, cases[0]),
-            cost=[diagnostics.stability_parameter(c["g0"], c["theta0_deg"]) for c in cases],
-            model=model)
-        options = config.step_options()._replace(rtol=float(rtol))
-        result = run(options=options, tail_tol=config.tail_tol)
-        twins = None
-        if twin:
-            twin_rtol, twin_atol, twin_tail = outcomes.twin_tolerances(
-                options.rtol, options.atol, config.tail_tol)
-            twins = run(options=options._replace(rtol=twin_rtol, atol=twin_atol),
-                        tail_tol=twin_tail)
-        outputs.append((members, x0, method, result, twins))
-    wall = time.perf_counter() - start - (_jitcache.compile_seconds() - compiled)
+    return groups
+
+
+def _run_group(config, key, members):
+    """One group's cases (and their twins) in the batch kernel: a :class:`GroupRun`."""
+    model, _, method, rtol, twin = key
+    cases = [config.cases[i] for i in members]
+    x0 = [shapes.start_shape(**_start(c))[0] for c in cases]
+    run = functools.partial(
+        refinement.integrate_cases, integrators.METHODS[method],
+        [models.case_parameters(model, c["g0"], config.w) for c in cases], x0,
+        [case_option(config, c, "t_end") for c in cases],
+        ladder=case_ladder(config, cases[0]),
+        cost=[diagnostics.stability_parameter(c["g0"], c["theta0_deg"]) for c in cases],
+        model=model)
+    options = config.step_options()._replace(rtol=float(rtol))
+    result = run(options=options, tail_tol=config.tail_tol)
+    twins = None
+    if twin:
+        twin_rtol, twin_atol, twin_tail = outcomes.twin_tolerances(
+            options.rtol, options.atol, config.tail_tol)
+        twins = run(options=options._replace(rtol=twin_rtol, atol=twin_atol),
+                    tail_tol=twin_tail)
+    return GroupRun(members, x0, method, result, twins)
+
+
+def _group_rows(config, group, wall, total_rhs):
+    """{case id: row} of a :class:`GroupRun`; each case's ``wall_s`` is its share of
+    ``wall`` by RHS evaluations (``total_rhs`` in all)."""
     nfev = integrators.COUNTS.index("nfev")
-    total_rhs = sum(int(result.counts[:, nfev].sum())
-                    + (0 if twins is None else int(twins.counts[:, nfev].sum()))
-                    for *_, result, twins in outputs) or 1
-    rows = {}
-    for members, x0, method, (x_final, _, t_final, status, counts, worst), twins in outputs:
-        for b, case_id in enumerate(members):
-            case = config.cases[case_id]
-            twin = None
-            if twins is not None:
-                twin = dict(outcomes.end_state(
-                    case["theta0_deg"], diagnostics.aspect_ratio(x0[b]), twins.x_final[b],
-                    int(twins.status[b]) in integrators.SUCCESS, config.thresholds),
-                    nfev=int(twins.counts[b, nfev]))
-            rows[case_id] = _result_row(
-                config, case_id, case, x0[b], x_final[b], int(status[b]),
-                counts[b], worst[b], wall * threads * counts[b, nfev] / total_rhs,
-                float(t_final[b]), method, twin)
-    snapshots = []
-    for case_id in traced:
-        rows[case_id], table = _traced_case(config, case_id)
-        snapshots.append(table)
-    table = pa.Table.from_pylist([rows[i] for i in sorted(rows)], schema=io.RESULT_SCHEMA)
-    return table, (pa.concat_tables(snapshots) if snapshots else None)
+    run, twins, rows = group.run, group.twins, {}
+    for b, case_id in enumerate(group.members):
+        case = config.cases[case_id]
+        twin = None
+        if twins is not None:
+            twin = dict(outcomes.end_state(
+                case["theta0_deg"], diagnostics.aspect_ratio(group.x0[b]), twins.x_final[b],
+                int(twins.status[b]) in integrators.SUCCESS, config.thresholds),
+                nfev=int(twins.counts[b, nfev]))
+        rows[case_id] = _result_row(
+            config, case_id, case, group.x0[b], run.x_final[b], int(run.status[b]),
+            run.counts[b], run.worst[b], wall * run.counts[b, nfev] / total_rhs,
+            float(run.t_final[b]), group.method, twin)
+    return rows
 
 
 def run_piece(config, piece, threads=None, out=None, fingerprint=None):

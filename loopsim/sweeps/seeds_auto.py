@@ -1,14 +1,14 @@
 """``--seeds auto``: rounds of sweeps that add seeds to each cell until its answer is sharp.
 
-The directory (``io.seedsdir``) holds the cells, the targets and the sweep's other
+The directory (``storage.seedsdir``) holds the cells, the targets and the sweep's other
 options, one ordinary sweep directory per round (checksummed, resumable) and, once every
 cell has stopped, the stop table: one row per cell saying why it stopped
-(``seeding``: failed, deterministic, sharp or cap).  Round r's cases are planned from the rows of
-rounds < r only, by ``seeding.decide``; those rows are reproducible bit for bit, so
+(``seeds_auto_rule``: failed, deterministic, sharp or cap).  Round r's cases are planned from the rows of
+rounds < r only, by ``seeds_auto_rule.decide``; those rows are reproducible bit for bit, so
 re-running the command after an interruption plans the same rounds and resumes the one
 it stopped in.  Each round's configuration fingerprint is recorded in the directory's
 record before the round runs, so that a round copied in from elsewhere is refused on
-read as on resume (``io.check_rounds``).  Orchestration only: the rule is ``seeding``,
+read as on resume (``storage.check_rounds``).  Orchestration only: the rule is ``seeds_auto_rule``,
 the runs ``run_sweep``.
 """
 import dataclasses
@@ -18,11 +18,13 @@ import os
 import pandas as pd
 import pyarrow as pa
 
-from .. import columns, io, outcomes, seeding, summary, validation
+from .. import (
+    columns, outcome_statistics, outcomes, seeds_auto_rule, storage, validation,
+)
 from .cases import validate
 
 #: The inputs that tell the cells apart (the seed never does).  Every other input of a
-#: cell (``summary.CELL_INPUTS``: model, slenderness, rtol, t_end, method, w ...) is one
+#: cell (``outcome_statistics.CELL_INPUTS``: model, slenderness, rtol, t_end, method, w ...) is one
 #: option of the whole sweep here: ``--seeds auto`` takes a grid, never a cases file.
 CELL_KEYS = ("g0", "theta0_deg", "n", "perturbation")
 _NO_ROWS = pd.DataFrame(dict(regime=[], theta_final_deg=[], aspect_ratio=[], seed=[]))
@@ -39,12 +41,12 @@ def _record(config, targets):
 
 
 def _differences(stored, record):
-    """The record's keys whose stored value differs (``io.FINGERPRINT_IGNORES`` left out:
+    """The record's keys whose stored value differs (``storage.FINGERPRINT_IGNORES`` left out:
     the chunk size may change on resume)."""
-    defaults = dataclasses.asdict(seeding.SeedTargets())
+    defaults = dataclasses.asdict(seeds_auto_rule.SeedTargets())
     changed = [f"targets.{k}" for k in record["targets"]
                if stored.get("targets", {}).get(k, defaults[k]) != record["targets"][k]]
-    changed += [k for k in record["config"] if k not in io.FINGERPRINT_IGNORES
+    changed += [k for k in record["config"] if k not in storage.FINGERPRINT_IGNORES
                 and stored.get("config", {}).get(k) != record["config"][k]]
     if stored.get("layout") != record["layout"] and not changed:
         changed = ["its layout"]
@@ -56,14 +58,14 @@ def prepare(out, config, targets, command_line):
     (the same cells, targets and options, the chunk size aside); a one-line ValueError
     otherwise.  Returns what it made (paths, deepest last) for :func:`_undo`."""
     record = _record(config, targets)
-    stored = io.read_seeds_file(out)
+    stored = storage.read_seeds_file(out)
     if stored is not None:
         changed = _differences(stored, record)
         if changed:
             raise ValueError(f"{out!r} holds a different --seeds auto sweep (differs in: "
                              f"{', '.join(changed)}); use another --out")
         return []
-    if os.path.isfile(os.path.join(out, io.SWEEP_FILE)):
+    if os.path.isfile(os.path.join(out, storage.SWEEP_FILE)):
         raise ValueError(f"{out!r} holds a sweep with fixed --seeds; use another --out")
     made = []
     missing = os.path.abspath(out)
@@ -71,10 +73,10 @@ def prepare(out, config, targets, command_line):
         made.insert(0, missing)
         missing = os.path.dirname(missing)
     os.makedirs(out, exist_ok=True)
-    io.write_json_atomically(dict(record, rounds=[], command_line=command_line or [],
-                                  **json.loads(json.dumps(io.provenance()))),
-                             os.path.join(out, io.SEEDS_FILE))
-    return made + [os.path.join(out, io.SEEDS_FILE)]
+    storage.write_json_atomically(dict(record, rounds=[], command_line=command_line or [],
+                                  **json.loads(json.dumps(storage.provenance()))),
+                             os.path.join(out, storage.SEEDS_FILE))
+    return made + [os.path.join(out, storage.SEEDS_FILE)]
 
 
 def _undo(made):
@@ -90,16 +92,17 @@ def _undo(made):
 def _record_round(out, index, fingerprint):
     """Record round ``index``'s fingerprint in the directory's record before it runs; a
     ValueError if another one is recorded there (its rows would not be this sweep's)."""
-    stored = io.read_seeds_file(out)
+    stored = storage.read_seeds_file(out)
     rounds = stored.setdefault("rounds", [])
     if index < len(rounds):
         if rounds[index] != fingerprint:
-            raise ValueError(f"{io.round_directory(out, index)!r} was planned with other cases "
+            raise ValueError(f"{storage.round_directory(out, index)!r} was planned with other "
+                             "cases "
                              "than this sweep's rows now ask for (a round replaced, or rows "
                              "changed); use another --out")
         return
     stored["rounds"] = rounds + [fingerprint]
-    io.write_json_atomically(stored, os.path.join(out, io.SEEDS_FILE))
+    storage.write_json_atomically(stored, os.path.join(out, storage.SEEDS_FILE))
 
 
 def check_size(cells, targets):
@@ -121,20 +124,20 @@ def _groups(rows):
 def _sampled(rows, targets):
     """Whether a cell with finished ``rows`` is checked in distribution (and so runs its
     later seeds without twins): its runs are samples and ``check_seeds`` > 0."""
-    return targets.check_seeds > 0 and len(rows) > 0 and seeding.runs_are_samples(rows)
+    return targets.check_seeds > 0 and len(rows) > 0 and seeds_auto_rule.runs_are_samples(rows)
 
 
 def plan_round(cells, rows, targets, twins=True):
     """The next round's cases: for each cell (a case dict; its seed is ignored) whose rows
     so far (``rows``, a DataFrame or None) do not decide it, the seeds from its count up to
-    the size ``seeding.decide`` asks for; without twins (``twin=False``) where the sweep
+    the size ``seeds_auto_rule.decide`` asks for; without twins (``twin=False``) where the sweep
     runs them (``twins``) but the cell's runs are samples."""
     groups = _groups(rows)
     cases = []
     for cell in cells:
         have = groups.get(cell_key(cell), _NO_ROWS)
-        reason, wanted = seeding.decide(have, targets)
-        if reason == seeding.CONTINUE:
+        reason, wanted = seeds_auto_rule.decide(have, targets)
+        if reason == seeds_auto_rule.CONTINUE:
             extra = dict(twin=False) if twins and _sampled(have, targets) else {}
             cases.extend(dict(cell, seed=seed, **extra) for seed in range(len(have), wanted))
     return cases
@@ -202,7 +205,7 @@ def check_config(config, cases):
                                twin=False)
 
 
-#: The check's columns in the stop table, from ``summary.compare``.
+#: The check's columns in the stop table, from ``outcome_statistics.compare``.
 CHECK_COLUMNS = {"seeds_b": "check_seeds", "verdict": "check_verdict",
                  "tilt_ks_p": "check_tilt_ks_p", "aspect_ks_p": "check_aspect_ks_p",
                  "regime_p": "check_regime_p", "tilt_wasserstein": "check_tilt_wasserstein"}
@@ -210,10 +213,10 @@ CHECK_COLUMNS = {"seeds_b": "check_seeds", "verdict": "check_verdict",
 
 def _runs(rows):
     """How a cell's answer was decided: "none" (no run succeeded), "samples"
-    (``seeding.runs_are_samples``) or "trajectories"."""
-    if not seeding.any_succeeded(rows):
+    (``seeds_auto_rule.runs_are_samples``) or "trajectories"."""
+    if not seeds_auto_rule.any_succeeded(rows):
         return "none"
-    return "samples" if seeding.runs_are_samples(rows) else "trajectories"
+    return "samples" if seeds_auto_rule.runs_are_samples(rows) else "trajectories"
 
 
 def stop_table(cells, rows, targets, checks=None):
@@ -225,7 +228,7 @@ def stop_table(cells, rows, targets, checks=None):
     its check runs, ``checks``; :func:`stricter_sample`)."""
     groups = _groups(rows)
     table = pd.DataFrame([
-        dict(seeding.cell_record(CELL_KEYS, cell_key(cell), groups[cell_key(cell)], targets,
+        dict(seeds_auto_rule.cell_record(CELL_KEYS, cell_key(cell), groups[cell_key(cell)], targets,
                                  int(groups[cell_key(cell)]["round"].max()) + 1),
              runs=_runs(groups[cell_key(cell)]),
              twins=int(groups[cell_key(cell)]["determined"].notna().sum()))
@@ -238,7 +241,7 @@ def stop_table(cells, rows, targets, checks=None):
     if stricter is not None:
         sampled = pd.concat([groups[cell_key(cell)] for cell in cells
                              if _sampled(groups[cell_key(cell)], targets)])
-        verdicts = summary.compare(sampled, stricter, by=list(CELL_KEYS)).rename(
+        verdicts = outcome_statistics.compare(sampled, stricter, by=list(CELL_KEYS)).rename(
             columns=CHECK_COLUMNS)
         keys = list(CELL_KEYS)
         table = table.drop(columns=list(CHECK_COLUMNS.values())).merge(
@@ -268,8 +271,8 @@ def run_seeds_auto(config, out, targets, *, run_round, command_line=None, announ
     validate(dataclasses.replace(config, cases=cells))  # distinct cells among the rest
     check_size(cells, targets)
     made = prepare(out, config, targets, command_line)
-    if not made and os.path.isfile(os.path.join(out, io.STOPS_FILE)):
-        return io.read_seeds_auto(out), io.read_stop_table(out)
+    if not made and os.path.isfile(os.path.join(out, storage.STOPS_FILE)):
+        return storage.read_seeds_auto(out), storage.read_stop_table(out)
     rows = None
     index = 0
     try:
@@ -284,14 +287,14 @@ def run_seeds_auto(config, out, targets, *, run_round, command_line=None, announ
                          + (f" ({sampled} without twins: their cells' runs are samples)"
                             if sampled else ""))
             round_config = dataclasses.replace(config, cases=cases)
-            _record_round(out, index, io.config_fingerprint(
+            _record_round(out, index, storage.config_fingerprint(
                 json.loads(json.dumps(round_config.as_dict()))))
-            frame = run_round(round_config, io.round_directory(out, index),
+            frame = run_round(round_config, storage.round_directory(out, index),
                               expected_costs(cases, rows, config.twin)).assign(round=index)
             rows = frame if rows is None else pd.concat([rows, frame], ignore_index=True)
             index += 1
     except BaseException:
-        if made and not os.path.isdir(io.round_directory(out, 0)):
+        if made and not os.path.isdir(storage.round_directory(out, 0)):
             _undo(made)
         raise
     checks = None
@@ -301,11 +304,12 @@ def run_seeds_auto(config, out, targets, *, run_round, command_line=None, announ
             announce(f"seeds auto: distribution check: {len({cell_key(c) for c in cases})} "
                      f"cells whose runs are samples, {len(cases)} cases at 10x stricter "
                      "tolerances")
-        checks = run_round(check_config(config, cases), os.path.join(out, io.CHECK_DIR),
+        checks = run_round(check_config(config, cases), os.path.join(out, storage.CHECK_DIR),
                            expected_costs(cases, rows, twins=False))
     table = stop_table(cells, rows, targets, checks)
-    meta = io.provenance(seeds_auto_targets=json.dumps(dataclasses.asdict(targets)))
-    io.write_table_atomically(io.described(pa.Table.from_pandas(table, preserve_index=False)
-                                           .replace_schema_metadata(meta), columns.STOP_COLUMNS),
-                              os.path.join(out, io.STOPS_FILE))
-    return io.read_seeds_auto(out), table
+    meta = storage.provenance(seeds_auto_targets=json.dumps(dataclasses.asdict(targets)))
+    storage.write_table_atomically(
+        storage.described(pa.Table.from_pandas(table, preserve_index=False)
+                          .replace_schema_metadata(meta), columns.STOP_COLUMNS),
+        os.path.join(out, storage.STOPS_FILE))
+    return storage.read_seeds_auto(out), table

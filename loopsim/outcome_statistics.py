@@ -234,7 +234,7 @@ def outcome_counts(frame):
 
 
 def stop_counts(stops):
-    """The counts of a ``--seeds auto`` stop table (``io.read_stop_table``) that ``loopsim
+    """The counts of a ``--seeds auto`` stop table (``storage.read_stop_table``) that ``loopsim
     sweep`` closes with: ``points``, ``reasons`` ({stop_reason: points}), ``seeds_min``,
     ``seeds_max`` (seeds per point)."""
     return dict(points=len(stops),

@@ -1,4 +1,5 @@
-"""JIT options and numerical defaults, kept in one place.
+"""Numerical and run defaults, kept in one place (the JIT options are ``jit.JIT``; the
+OSError numbers the command line exits 3 on, ``exit_codes.ENVIRONMENT_ERRNOS``).
 
 Conventions used throughout loopsim (stated once, tested in ``tests/``):
 
@@ -18,32 +19,6 @@ Conventions used throughout loopsim (stated once, tested in ``tests/``):
 * The tension reported to users is the physical axial force
   N = T + |x''|², not the Lagrange multiplier T (see ``diagnostics``).
 """
-
-import errno
-
-# No fastmath: results must be bit-reproducible across thread counts.
-_JIT = dict(cache=True, nogil=True, error_model="numpy")
-
-
-def __getattr__(name):
-    """``JIT``, the options of every kernel, handed out only once Numba's cache points at
-    loopsim's (``_jitcache.configure``): every kernel module imports it before its first
-    decorator, so the cache is set up exactly when the first kernel is defined, and the
-    command line, which defines none, loads neither Numba nor NumPy (``--help`` is fast)."""
-    if name == "JIT":
-        from . import _jitcache
-
-        _jitcache.configure()
-        globals()["JIT"] = _JIT
-        return _JIT
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-#: OSError numbers that are the machine's fault, not the input's: the command line exits
-#: 3 on them (a full disk, a read-only filesystem, an I/O error, no memory or files left,
-#: a file-size limit reached: ``ulimit -f``, or the filesystem's largest file).
-ENVIRONMENT_ERRNOS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EIO,
-                                errno.ENOMEM, errno.EMFILE, errno.ENFILE, errno.EFBIG})
 
 #: Default penalty rate of the length-creation term (docs/model.md, "Choice of the length
 #: penalty w").
@@ -107,7 +82,7 @@ DEFAULT_TAIL_TOL = RESOLVED_TAIL
 #: order starts there.
 INITIAL_CONTENT_TOL = 1e-12
 #: ``--seeds auto``'s targets, by option name (``--p-halfwidth``, ``sweep(p_halfwidth=)``):
-#: (``seeding.SeedTargets`` field, default).  The defaults are defended in
+#: (``seeds_auto_rule.SeedTargets`` field, default).  The defaults are defended in
 #: docs/distributions.md, "Seeds until the answer is sharp".
 SEED_TARGETS = {
     "p_halfwidth": ("p_halfwidth", 0.15),

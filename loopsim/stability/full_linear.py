@@ -62,7 +62,7 @@ import math
 import numpy as np
 
 from .. import models, spectral, validation
-from ..config import DEFAULT_W
+from ..defaults import DEFAULT_W
 from ..models import local_sbt
 from ..shapes import inclined_circle
 from . import paper

@@ -182,7 +182,7 @@ def read_stop_table(out):
     ------
     ValueError
         The sweep has not finished (no stop table yet).
-    loopsim.io.DamagedFile
+    loopsim.storage.DamagedFile
         The stop table fails its checksums or content hash.
 
     Examples

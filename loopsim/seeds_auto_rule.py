@@ -18,7 +18,7 @@ seeds end in different regimes, or some run's stricter twin ends elsewhere) need
 twins: each would only prove once more that one run is a sample.  Its later seeds run
 without twins, and its distribution is checked instead against a subsample at the twins'
 stricter tolerances (``check_seeds`` seeds, ``sweeps.seeds_auto``; verdict by
-``summary.compare``).
+``outcome_statistics.compare``).
 
 The rule reads only a cell's finished rows, which are reproducible bit for bit, so the
 rounds it plans are too: a resumed ``--seeds auto`` sweep plans what the interrupted one
@@ -30,9 +30,9 @@ import math
 
 import numpy as np
 
-from .config import SEED_TARGETS
+from .defaults import SEED_TARGETS
 from .outcomes import REGIMES
-from .summary import bootstrap_interval, wilson_interval
+from .outcome_statistics import bootstrap_interval, wilson_interval
 
 #: Why a cell stopped adding seeds (``stop_reason``); ``CONTINUE`` while it has not.
 FAILED, DETERMINISTIC, SHARP, CAP, CONTINUE = "failed", "deterministic", "sharp", "cap", ""

@@ -1,4 +1,4 @@
-"""Outcomes as distributions (loopsim.summary): the Wilson interval and the bootstrap
+"""Outcomes as distributions (loopsim.outcome_statistics): the Wilson interval and the bootstrap
 against closed forms and known cases, cells and their counts, the command."""
 import json
 
@@ -8,35 +8,35 @@ import pyarrow.parquet as pq
 import pytest
 
 import loopsim
-from loopsim import columns, summary
+from loopsim import columns, outcome_statistics
 from loopsim.cli import main
 
 
 def test_wilson_interval_closed_forms():
-    z = summary.Z95
-    assert summary.wilson_interval(0, 10) == pytest.approx((0.0, z * z / (10 + z * z)))
-    assert summary.wilson_interval(10, 10) == pytest.approx((10 / (10 + z * z), 1.0))
-    low, high = summary.wilson_interval(5, 10)
+    z = outcome_statistics.Z95
+    assert outcome_statistics.wilson_interval(0, 10) == pytest.approx((0.0, z * z / (10 + z * z)))
+    assert outcome_statistics.wilson_interval(10, 10) == pytest.approx((10 / (10 + z * z), 1.0))
+    low, high = outcome_statistics.wilson_interval(5, 10)
     assert low + high == pytest.approx(1.0) and high - low == pytest.approx(
         2 * z * np.sqrt(0.25 / 10 + z * z / 400) / (1 + z * z / 10))
     # a textbook value: 8 of 20 gives (0.2188, 0.6134) to four places
-    assert summary.wilson_interval(8, 20) == pytest.approx((0.2188, 0.6134), abs=1e-4)
-    assert all(np.isnan(summary.wilson_interval(0, 0)))
+    assert outcome_statistics.wilson_interval(8, 20) == pytest.approx((0.2188, 0.6134), abs=1e-4)
+    assert all(np.isnan(outcome_statistics.wilson_interval(0, 0)))
 
 
 def test_bootstrap_interval_is_seeded_and_covers_the_median():
-    assert summary.bootstrap_interval(np.full(9, 3.5)) == (3.5, 3.5)
+    assert outcome_statistics.bootstrap_interval(np.full(9, 3.5)) == (3.5, 3.5)
     rng = np.random.default_rng(1)
     sample = rng.normal(10.0, 2.0, 200)
-    first = summary.bootstrap_interval(sample, seed=7)
-    assert first == summary.bootstrap_interval(sample, seed=7)  # reproducible
-    assert first != summary.bootstrap_interval(sample, seed=8)
+    first = outcome_statistics.bootstrap_interval(sample, seed=7)
+    assert first == outcome_statistics.bootstrap_interval(sample, seed=7)  # reproducible
+    assert first != outcome_statistics.bootstrap_interval(sample, seed=8)
     # the median's standard error is about 1.2533 sigma / sqrt(N) = 0.177: the 95 %
     # interval spans about 4 of them
     assert first[0] < np.median(sample) < first[1]
     assert 0.4 < first[1] - first[0] < 1.1
     covered = sum(lo < 10.0 < hi for lo, hi in (
-        summary.bootstrap_interval(rng.normal(10.0, 2.0, 50), seed=k, resamples=500)
+        outcome_statistics.bootstrap_interval(rng.normal(10.0, 2.0, 50), seed=k, resamples=500)
         for k in range(100)))
     assert 85 <= covered <= 100
 
@@ -52,11 +52,11 @@ def test_summarize_groups_seeds_into_cells():
                              aspect_ratio=1.0 + seed / 100, nfev=100, twin_nfev=150,
                              wall_s=0.5,
                              stop_reason="t_end" if (g0 > 100 and seed == 5) else "steady"))
-    table = summary.summarize(pd.DataFrame(rows))
+    table = outcome_statistics.summarize(pd.DataFrame(rows))
     assert list(table["g0"]) == [30.0, 150.0] and "n" not in table and "seed" not in table
     stable, hot = table.iloc[0], table.iloc[1]
     assert stable["seeds"] == 8 and stable["p_stable"] == 1.0 and stable["determined"] == 7
-    assert stable["p_stable_low"] == pytest.approx(8 / (8 + summary.Z95 ** 2))
+    assert stable["p_stable_low"] == pytest.approx(8 / (8 + outcome_statistics.Z95 ** 2))
     assert hot["p_3d"] == 0.75 and hot["p_in_plane"] == 0.25 and hot["p_failed"] == 0.0
     assert hot["tilt_median"] == 23.5 and hot["tilt_q25"] == 21.75
     assert hot["tilt_median_low"] <= 23.5 <= hot["tilt_median_high"]
@@ -64,11 +64,11 @@ def test_summarize_groups_seeds_into_cells():
     assert stable["steady"] == 8 and hot["steady"] == 7  # seed 5 still moving at t_end
     frame = pd.DataFrame(rows)
     frame.attrs["loopsim"] = dict(sweep_config=dict(early_stop=False))  # --no-early-stop
-    assert summary.summarize(frame)["steady"].isna().all()  # unknown, not 0 (issue 46.4)
+    assert outcome_statistics.summarize(frame)["steady"].isna().all()  # unknown, not 0 (issue 46.4)
     frame.attrs["loopsim"] = dict(sweep_config=dict(early_stop=True))
-    assert summary.summarize(frame)["steady"].tolist() == [8, 7]
+    assert outcome_statistics.summarize(frame)["steady"].tolist() == [8, 7]
     with pytest.raises(ValueError, match="no column"):
-        summary.summarize(pd.DataFrame(rows), by=["colour"])
+        outcome_statistics.summarize(pd.DataFrame(rows), by=["colour"])
 
 
 def test_summary_command_on_a_sweep_with_seeds(tmp_path, capsys):
@@ -76,7 +76,7 @@ def test_summary_command_on_a_sweep_with_seeds(tmp_path, capsys):
     assert main(["sweep", "--n", "6", "--g0", "10,40", "--theta0", "30", "--seeds", "3", "--t-end", "0.5",
                  "--no-twin", "--quiet", "--out", str(out)]) == 0
     capsys.readouterr()
-    path = tmp_path / "cells" / "summary.parquet"
+    path = tmp_path / "cells" / "outcome_statistics.parquet"
     assert main(["summary", str(out), "--out", str(path)]) == 0
     printed = capsys.readouterr().out
     assert "p_stable" in printed and f"table: {path}" in printed
@@ -100,21 +100,22 @@ def test_compare_verdicts_on_one_distribution_and_on_shifted_ones():
     rng = np.random.default_rng(3)
     same_a, same_b = rng.normal(20, 5, 40), rng.normal(20, 5, 40)
     shifted = rng.normal(30, 5, 40)
-    same = summary.compare(_seeds_table(same_a), _seeds_table(same_b))
-    assert same["verdict"].tolist() == [summary.SAME]
+    same = outcome_statistics.compare(_seeds_table(same_a), _seeds_table(same_b))
+    assert same["verdict"].tolist() == [outcome_statistics.SAME]
     assert same["tilt_ks_p"].iloc[0] > 0.05 and same["seeds_a"].iloc[0] == 40
     low, high = same[["tilt_wasserstein_low", "tilt_wasserstein_high"]].iloc[0]
     assert low <= same["tilt_wasserstein"].iloc[0] <= high
-    different = summary.compare(_seeds_table(same_a), _seeds_table(shifted))
-    assert different["verdict"].tolist() == [summary.DIFFERENT]
+    different = outcome_statistics.compare(_seeds_table(same_a), _seeds_table(shifted))
+    assert different["verdict"].tolist() == [outcome_statistics.DIFFERENT]
     assert different["tilt_ks_p"].iloc[0] < 1e-4
     assert 7 < different["tilt_wasserstein"].iloc[0] < 13  # the shift is 10
     # regimes alone: the same tilts, but half the seeds in plane in one table
-    regimes = summary.compare(_seeds_table(same_a),
+    regimes = outcome_statistics.compare(_seeds_table(same_a),
                               _seeds_table(same_a, ["3d", "in-plane"] * 20))
-    assert regimes["regime_p"].iloc[0] < 1e-4 and regimes["verdict"].iloc[0] == summary.DIFFERENT
+    assert regimes["regime_p"].iloc[0] < 1e-4
+    assert regimes["verdict"].iloc[0] == outcome_statistics.DIFFERENT
     with pytest.raises(ValueError, match="share no cell"):
-        summary.compare(_seeds_table(same_a), _seeds_table(same_b, g0=10.0))
+        outcome_statistics.compare(_seeds_table(same_a), _seeds_table(same_b, g0=10.0))
 
 
 def test_compare_command_on_two_sweeps(tmp_path, capsys):
@@ -154,12 +155,12 @@ def test_summary_figures_draw_every_cell():
                                  wall_s=0.1, q_final=g0 / 10 + seed,
                                  stop_reason="t_end" if (g0 > 100 and seed == 1) else "steady"))
     frame = pd.DataFrame(rows)
-    cells = summary.summarize(frame)
+    cells = outcome_statistics.summarize(frame)
     fig = figures.probability_phase_diagram(cells, style="colour")
     marks = [c for c in fig.axes[0].collections
              if c.get_label() == "some seeds not steady at t_end"]
     assert len(marks) == 1 and len(marks[0].get_offsets()) == 2  # the two cells at g0 = 150
-    no_early_stop = summary.summarize(frame.assign(stop_reason="t_end"))
+    no_early_stop = outcome_statistics.summarize(frame.assign(stop_reason="t_end"))
     fig = figures.probability_phase_diagram(no_early_stop, style="colour")
     assert not [c for c in fig.axes[0].collections
                 if c.get_label() == "some seeds not steady at t_end"]  # no run was tested
@@ -218,7 +219,7 @@ def test_cells_are_kept_apart_by_model_and_slenderness():
     frame = pd.DataFrame(_model_rows("nonlocal", 1e-2, [64.9, 72.0, 79.1])
                          + _model_rows("nonlocal", 1e-3, [15.4, 18.0, 22.4])
                          + _model_rows("local", np.nan, [40.0]))
-    table = summary.summarize(frame)
+    table = outcome_statistics.summarize(frame)
     assert table.attrs["loopsim_summary"]["cells_by"] == ["g0", "theta0_deg", "model",
                                                           "slenderness"]
     assert len(table) == 3 and list(table["seeds"]) == [1, 3, 3]
@@ -226,11 +227,12 @@ def test_cells_are_kept_apart_by_model_and_slenderness():
     assert by_eps[1e-2] == 72.0 and by_eps[1e-3] == 18.0
     assert table.loc[table["model"] == "local", "tilt_median"].item() == 40.0
     # compare pairs cell with cell, the local row never merged into a nonlocal cell
-    pairs = summary.compare(frame, frame.assign(theta_final_deg=frame["theta_final_deg"] + 1))
+    pairs = outcome_statistics.compare(
+        frame, frame.assign(theta_final_deg=frame["theta_final_deg"] + 1))
     assert len(pairs) == 3 and list(pairs["seeds_a"]) == [1, 3, 3]
     # one table sweeping the slenderness, the other not: only the shared cell pairs
     other = pd.DataFrame(_model_rows("nonlocal", 1e-3, [15.0, 18.5, 22.0]))
-    pairs = summary.compare(frame, other)
+    pairs = outcome_statistics.compare(frame, other)
     assert len(pairs) == 1 and pairs["slenderness"].item() == 1e-3
 
 
@@ -239,9 +241,9 @@ def test_a_cell_holding_one_seed_twice_is_refused():
     each) are not one cell of two seeds."""
     frame = pd.DataFrame(_model_rows("local", np.nan, [10.0]) * 2)
     with pytest.raises(ValueError, match=r"holds seed 0 2 times"):
-        summary.summarize(frame)
+        outcome_statistics.summarize(frame)
     with pytest.raises(ValueError, match=r"holds seed 0 2 times"):
-        summary.compare(frame, frame)
+        outcome_statistics.compare(frame, frame)
 
 
 def test_summary_figure_of_cells_sharing_a_point_is_refused_before_writing(tmp_path, capsys):

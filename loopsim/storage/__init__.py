@@ -5,7 +5,7 @@ coefficient layout, the run or sweep configuration); files are written to a
 temporary name and renamed into place.
 
 Three modules, each importing only those before it; every public name is
-re-exported here (``loopsim.io.read_results`` and so on):
+re-exported here (``loopsim.storage.read_results`` and so on):
 
 * ``integrity``: atomic writes, temporaries, content hashes, the checked reader;
 * ``tables``: schemas, provenance, trajectory tables, a file's metadata;

@@ -24,7 +24,7 @@ With n = 1 there are no modes to perturb and the circle is returned as is.
 import numpy as np
 
 from .. import diagnostics, spectral
-from ..config import DEFAULT_PERTURBATION
+from ..defaults import DEFAULT_PERTURBATION
 
 #: The ensemble every probability over seeds is taken over, in one line (named in
 #: ``--help``, in summary tables' metadata and in docs/convergence-top.md).
