@@ -191,6 +191,54 @@ STOP_COLUMNS = {
 }
 
 
+def _difference_columns(stat, unit, what):
+    """The four columns of one difference (setting − default) in a convergence table."""
+    return {f"delta_{stat}": (unit, f"{what}: this setting's minus the default's"),
+            f"delta_{stat}_low": (unit, "lower end of its 95% interval (Newcombe for a "
+                                        "probability, percentile bootstrap for a quantile)"),
+            f"delta_{stat}_high": (unit, "upper end of its 95% interval"),
+            f"delta_{stat}_detectable": (unit, "smallest difference the comparison detects "
+                                               "with 80% power at these sample sizes")}
+
+
+#: name: (unit, description) of every column of the convergence table
+#: (``scripts/convergence_study.py``, ``data/convergence_top.parquet``): one row per cell
+#: and setting; the ``delta_*`` columns compare the setting with the default one
+#: (``loopsim.distribution_differences``; empty on the default's own rows).
+CONVERGENCE_COLUMNS = {
+    "g0": RESULT_COLUMNS["g0"],
+    "theta0_deg": RESULT_COLUMNS["theta0_deg"],
+    "q0": RESULT_COLUMNS["q0"],
+    "setting": (TEXT, "default, rtol1e-8, n40 or amp1e-4 (the sweep options: the table's "
+                      "metadata, loopsim_convergence)"),
+    "seeds": (COUNT, "seeds of the cell at this setting"),
+    "failed": (COUNT, "of them, runs that failed"),
+    **{f"p_{name}{end}": (PROBABILITY, f"share of the seeds {what}" + (
+        "" if not end else f": {end[1:]} end of its 95% Wilson interval"))
+       for name, what in (("stable", "ending stable"), ("in_plane", "ending in-plane"),
+                          ("3d", "ending 3D"),
+                          ("steady", "that reached a steady state before t_end"))
+       for end in ("", "_low", "_high")},
+    "certain_regime": (TEXT, "the regime whose 95% Wilson lower bound is >= 0.8, if any "
+                             "(loopsim.distribution_differences.certain)"),
+    "tilt_q25": (DEG, "terminal tilt, first quartile over the seeds"),
+    "tilt_q50": (DEG, "terminal tilt, median over the seeds"),
+    "tilt_q75": (DEG, "terminal tilt, third quartile over the seeds"),
+    "tilt_q50_low": (DEG, "lower end of the median's 95% percentile-bootstrap interval"),
+    "tilt_q50_high": (DEG, "upper end of the median's 95% percentile-bootstrap interval"),
+    "nfev_mean": (COUNT, "right-hand-side evaluations per run, mean over the seeds"),
+    "wall_s": ("s", "wall time of the cell's runs, summed (shared machine)"),
+    **_difference_columns("p_in_plane", PROBABILITY, "P(in-plane)"),
+    **_difference_columns("p_3d", PROBABILITY, "P(3D)"),
+    **_difference_columns("p_steady", PROBABILITY, "P(steady before t_end)"),
+    **{k: v for q in (25, 50, 75)
+       for k, v in _difference_columns(f"tilt_q{q}", DEG, f"terminal tilt quantile {q}%")
+       .items()},
+    "verdict": (TEXT, "different (a Bonferroni interval excludes 0) or same (within the "
+                      "intervals); empty on the default's rows"),
+}
+
+
 def field_metadata(name, table=RESULT_COLUMNS):
     """Parquet field metadata of a column: {b"unit": ..., b"description": ...}."""
     unit, description = table[name]
@@ -209,7 +257,8 @@ def markdown(table=RESULT_COLUMNS):
 
 #: The tables ``python -m loopsim.columns [NAME]`` prints.
 TABLES = {"results": RESULT_COLUMNS, "trajectory": TRAJECTORY_COLUMNS,
-          "summary": SUMMARY_COLUMNS, "compare": COMPARE_COLUMNS, "stops": STOP_COLUMNS}
+          "summary": SUMMARY_COLUMNS, "compare": COMPARE_COLUMNS, "stops": STOP_COLUMNS,
+          "convergence": CONVERGENCE_COLUMNS}
 
 if __name__ == "__main__":
     import sys

@@ -28,6 +28,15 @@ DEFAULT_T_END = 10.0
 DEFAULT_RTOL = 1e-6
 DEFAULT_ATOL = 1e-9
 DEFAULT_PERTURBATION = 1e-3
+
+#: The ensemble every probability over seeds is taken over (``shapes.tilted_circle``'s
+#: recipe), in one line (named in
+#: ``--help``, in summary tables' metadata and in docs/convergence-top.md).
+PERTURBATION_ENSEMBLE = (
+    "seed k perturbs modes 2 to the starting order n (6 with --n auto, zero-padded as n "
+    "climbs) with amplitudes N(0,1)/m^2 from numpy.random.default_rng(k), scaled to RMS "
+    "size --perturbation (default 1e-3), the length kept 2 pi (a given shape: the same "
+    "draws in its own frame)")
 DEFAULT_SEED = 0
 DEFAULT_MAX_STEPS = 2_000_000
 #: Cases per chunk file of a sweep by default, and with ``n="auto"``, whose 3D cases take

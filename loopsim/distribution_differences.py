@@ -122,21 +122,23 @@ def compare_samples(a, b, probabilities, quantiles=TILT_QUANTILES, seed=0):
     Returns
     -------
     dict
-        ``<stat>_diff``, ``<stat>_low``, ``<stat>_high``, ``<stat>_detectable`` per
-        statistic (``p_<column>`` and ``tilt_q<percent>``), and ``verdict``:
-        :data:`DIFFERENT` when a Bonferroni interval (module docstring) excludes 0.
+        ``delta_<stat>``, ``delta_<stat>_low``, ``delta_<stat>_high``,
+        ``delta_<stat>_detectable`` per statistic (``p_<column>``, a leading ``is_``
+        dropped, and ``tilt_q<percent>``), and ``verdict``: :data:`DIFFERENT` when a
+        Bonferroni interval (module docstring) excludes 0.
     """
     statistics = len(probabilities) + len(quantiles)
     z_family = float(norm.ppf(1 - 0.05 / (2 * statistics)))
     out, differs = {}, False
     for column in probabilities:
         x, y = a[column].dropna().astype(bool), b[column].dropna().astype(bool)
-        name = f"p_{column}"
+        name = "delta_p_" + column.removeprefix("is_")
         if not (len(x) and len(y)):
-            out.update({f"{name}_{k}": np.nan for k in ("diff", "low", "high", "detectable")})
+            out.update({name: np.nan, **{f"{name}_{k}": np.nan
+                                         for k in ("low", "high", "detectable")}})
             continue
         hits_a, hits_b = int(x.sum()), int(y.sum())
-        out[f"{name}_diff"] = hits_b / len(y) - hits_a / len(x)
+        out[name] = hits_b / len(y) - hits_a / len(x)
         out[f"{name}_low"], out[f"{name}_high"] = newcombe_interval(hits_a, len(x), hits_b,
                                                                     len(y))
         out[f"{name}_detectable"] = detectable_probability_difference(hits_a / len(x), len(x),
@@ -144,11 +146,10 @@ def compare_samples(a, b, probabilities, quantiles=TILT_QUANTILES, seed=0):
         low, high = newcombe_interval(hits_a, len(x), hits_b, len(y), z_family)
         differs |= low > 0.0 or high < 0.0
     for i, quantile in enumerate(quantiles):
-        name = f"tilt_q{round(100 * quantile)}"
+        name = f"delta_tilt_q{round(100 * quantile)}"
         values = quantile_difference(a["theta_final_deg"], b["theta_final_deg"], quantile,
                                      seed=seed + i)
-        out.update(zip((f"{name}_diff", f"{name}_low", f"{name}_high", f"{name}_detectable"),
-                       values))
+        out.update(zip((name, f"{name}_low", f"{name}_high", f"{name}_detectable"), values))
         _, low, high, _ = quantile_difference(a["theta_final_deg"], b["theta_final_deg"],
                                               quantile, seed=seed + i,
                                               level=1 - 0.05 / statistics)

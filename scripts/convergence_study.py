@@ -37,11 +37,10 @@ import sys
 import numpy as np
 import pandas as pd
 import pyarrow as pa
-import pyarrow.parquet as pq
 
 import loopsim
 from loopsim import distribution_differences as dd
-from loopsim import outcome_statistics
+from loopsim import columns, outcome_statistics, storage
 
 G0 = np.linspace(10.0, 350.0, 15)  # the paper's grid
 G12 = ",".join(repr(float(v)) for v in G0[10:])  # 252.9 ... 350
@@ -119,6 +118,7 @@ def tabulate(frames):
                 if len(base):
                     row.update(dd.compare_samples(base, rows, ["is_in_plane", "is_3d",
                                                                "steady"]))
+                    row["verdict"] = row["verdict"].split(" ")[0]
             table.append(row)
     return pd.DataFrame(table).sort_values(["theta0_deg", "g0", "setting"], ignore_index=True)
 
@@ -162,12 +162,11 @@ def main():
                 certain=f"95% Wilson lower end >= {dd.CERTAIN_LOWER}",
                 power_of_detectable=dd.POWER, loopsim_version=loopsim.__version__)
     arrow = pa.Table.from_pandas(table, preserve_index=False)
-    arrow = arrow.replace_schema_metadata({**(arrow.schema.metadata or {}),
-                                           b"loopsim_convergence": json.dumps(meta).encode()})
+    arrow = arrow.replace_schema_metadata(storage.provenance(
+        loopsim_convergence=json.dumps(meta)))
     os.makedirs(os.path.dirname(args.out) or ".", exist_ok=True)
-    temporary = args.out + ".tmp"
-    pq.write_table(arrow, temporary)
-    os.replace(temporary, args.out)
+    storage.write_table_atomically(storage.described(arrow, columns.CONVERGENCE_COLUMNS),
+                                   args.out)
     with pd.option_context("display.width", 200, "display.max_columns", 30):
         print(table[["g0", "theta0_deg", "setting", "seeds", "p_3d", "p_steady", "tilt_q50",
                      "certain_regime"] + [c for c in ("verdict",) if c in table]].to_string())

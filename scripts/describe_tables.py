@@ -35,6 +35,7 @@ TABLES = {
     "seeds_auto_grid_compare_n32.parquet": columns.COMPARE_COLUMNS,
     "paper_range_summary.parquet": columns.SUMMARY_COLUMNS,
     "paper_range_stops.parquet": columns.STOP_COLUMNS,
+    "convergence_top.parquet": columns.CONVERGENCE_COLUMNS,
 }
 #: Columns that hold integer orders (written as floats before 0.3.0).
 INTEGER_COLUMNS = ("n",)

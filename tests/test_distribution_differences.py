@@ -91,7 +91,7 @@ def test_the_verdict_sees_a_large_difference():
     out = dd.compare_samples(_cell(rng, 32, 0.1), _cell(rng, 32, 0.95, tilt_shift=10.0),
                              ["is_3d", "steady"])
     assert out["verdict"] == dd.DIFFERENT
-    assert out["p_is_3d_low"] > 0 and out["tilt_q50_low"] > 0
+    assert out["delta_p_3d_low"] > 0 and out["delta_tilt_q50_low"] > 0
 
 
 def test_certain_means_a_wilson_lower_end_of_at_least_0_8():

@@ -1,6 +1,6 @@
 """``loopsim summary``: one row per cell of a sweep (regime probabilities, medians, with
 intervals), printed and optionally written and drawn."""
-from ..shapes.tilted_circle import PERTURBATION_ENSEMBLE
+from ..defaults import PERTURBATION_ENSEMBLE
 from .common import HelpFormatter, directory_name, print_and_write, use_agg
 
 

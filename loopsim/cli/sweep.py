@@ -3,8 +3,9 @@ when re-run; also reruns of a sweep's failed cases (``--rerun-failed``)."""
 import math
 import sys
 
-from ..defaults import DEFAULT_AUTO_CHUNK_SIZE, DEFAULT_CHUNK_SIZE, DEFAULT_N, SEED_TARGETS
-from ..shapes.tilted_circle import PERTURBATION_ENSEMBLE
+from ..defaults import (
+    DEFAULT_AUTO_CHUNK_SIZE, DEFAULT_CHUNK_SIZE, DEFAULT_N, PERTURBATION_ENSEMBLE, SEED_TARGETS,
+)
 from .common import (
     EXIT_FAILED_RUN, HelpFormatter, Parser, add_integration_options, check_auto_options,
     interrupted, real, use_agg,

@@ -26,13 +26,6 @@ import numpy as np
 from .. import diagnostics, spectral
 from ..defaults import DEFAULT_PERTURBATION
 
-#: The ensemble every probability over seeds is taken over, in one line (named in
-#: ``--help``, in summary tables' metadata and in docs/convergence-top.md).
-PERTURBATION_ENSEMBLE = (
-    "seed k perturbs modes 2 to the starting order n (6 with --n auto, zero-padded as n "
-    "climbs) with amplitudes N(0,1)/m^2 from numpy.random.default_rng(k), scaled to RMS "
-    "size --perturbation (default 1e-3), the length kept 2 pi (a given shape: the same "
-    "draws in its own frame)")
 
 
 def inclined_circle(n, theta0):
