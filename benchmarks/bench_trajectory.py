@@ -25,6 +25,7 @@ at the same error, interpolated log-log along radau5's work-precision curve.  Co
 deterministic; wall times are the median of ``--repeats``, methods alternating.
 """
 import argparse
+import importlib
 import json
 import os
 import sys
@@ -36,13 +37,25 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import loopsim  # noqa: E402
 from bench_kernels import import_baseline  # noqa: E402
-from bench_paths import run  # noqa: E402
 from loopsim import diagnostics, models, shapes  # noqa: E402
 
 RTOLS = (1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8)
 METHODS = ("radau5", "radau5-old", "lsoda", "bdf")
 LABELS = {"radau5": "radau5 (loopsim)", "radau5-old": "radau5 (loopsim at {rev})",
           "lsoda": "LSODA (scipy, loopsim's F and J)", "bdf": "BDF (scipy, loopsim's F and J)"}
+
+
+def run(problem, x0, t_end, rtol, package=loopsim):
+    """radau5 from x0 to t_end at rtol (atol = rtol / 1000) with ``package``'s driver:
+    (wall s, status, x, counts)."""
+    driver = importlib.import_module(package.__name__ + ".integrators.driver")
+    methods = importlib.import_module(package.__name__ + ".integrators")
+    radau5, options = methods.RADAU5, methods.step_options(rtol, rtol * 1e-3)
+    y_out = np.empty((1, x0.size))
+    start = time.perf_counter()
+    status, t, y, counts, _ = driver.integrate(radau5, problem, x0.ravel().copy(), 0.0, t_end,
+                                               np.array([t_end]), options, y_out)
+    return time.perf_counter() - start, int(status), y.reshape(x0.shape), counts
 
 
 def problem_of(package, g0, n):

@@ -45,8 +45,8 @@ def test_classification_thresholds_are_parameters():
 
 def test_resolved_flag_follows_both_thresholds():
     """A case is resolved only with a small transient length error AND a small spectral
-    tail along the run (the failure modes of scripts/resolution_study.py and
-    scripts/auto_study.py)."""
+    tail along the run (the failure modes of scripts/auto_study.py and of
+    scripts/distribution_study.py --check resolution)."""
     t = sweeps.Thresholds()
     assert t.resolved(2e-7, 1e-8)
     assert not t.resolved(1.5e-4, 1e-8)  # 3D at n = 6: length error, tiny tail
