@@ -152,19 +152,19 @@ def simulate(
     seed : int, default 0
         Seed of the perturbation.
     method : {"rkf45", "radau5", "auto"} or None, default None
-        The integrator; None: "auto" with ``n="auto"`` (chosen for the case,
-        ``refinement.auto_method``) and "rkf45" (the paper's) at a fixed n.
+        The integrator; None: "auto" (chosen per case, ``refinement.auto_method``) with
+        ``n="auto"`` and "rkf45" (the paper's) at a fixed n.
     max_steps : int, default 2000000
-        Most time steps.
+        Most time steps of a run.
     length_tol : float, default 0.25
-        Relative length error (dimensionless) at which the run stops as failed.
+        Relative length error (dimensionless) at which a run stops as failed.
     first_step, max_step, min_step : float or None, default None, inf, 0.0
         Step-size limits, in t_u (None: chosen by the integrator).
     steady_tol : float or None, default None
         Stop early once the shape and tilt change by less than this (dimensionless) per
         ``steady_interval``; None: integrate to ``t_span[1]``.
     steady_interval : float, default 0.5
-        Interval of the steady-state test, in t_u.
+        Interval of the steady-state test (``steady_tol``), in t_u.
     initial : array_like, str or None, default None
         Start from a given shape instead of the tilted circle: coefficients (3, 2m + 1)
         in L/2π, a point file (CSV/Parquet, columns x, y, z; fitted by arc length and
@@ -176,18 +176,21 @@ def simulate(
     initial_case_id : int or None, default None
         The case of a results ``initial`` holding several.
     n_max : int, default 32
-        With ``n="auto"``: the highest order (also capped by the model's, for nonlocal).
+        With ``n="auto"``: the highest order a run may reach (also capped by the model's,
+        for nonlocal).
     tail_tol : float, default 1e-5
-        With ``n="auto"``: the spectral-tail tolerance (dimensionless).
+        With ``n="auto"``: the spectral-tail tolerance (dimensionless) that restarts a run
+        at the next order.
     n_start : int or None, default None
         With ``n="auto"``: the first order; None: 6, or a given shape's (see ``initial``).
     twin : bool, default True
         Also run the twin at 10x stricter tolerances that says whether the outcome is
-        determined (``loopsim.outcomes``; about doubles the cost).
+        ``determined`` (``loopsim.outcomes``); run and twin together cost about 2.7x the
+        run alone (docs/auto-and-determinacy.md).
     model : {"local", "nonlocal"}, default "local"
-        The paper's local slender-body theory, or full slender-body theory
-        (docs/nonlocal.md), whose n must stay below its highest order
-        (``models.highest_order``).
+        The hydrodynamics: the paper's local slender-body theory, or full slender-body
+        theory (needs ``slenderness``; docs/nonlocal.md), whose n must stay below its
+        highest order (``models.highest_order``).
     slenderness : float or None, default None
         With ``model="nonlocal"``: ε = a/L, filament radius over loop length
         (dimensionless, in (0, 0.05]).

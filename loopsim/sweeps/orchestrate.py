@@ -136,8 +136,8 @@ def sweep(g0, theta0_deg, out, *, n="auto", seeds=1, method=None, t_end=DEFAULT_
         ``max_seeds`` (docs/distributions.md); the rows then get a ``round`` column and
         the stop table is ``loopsim.storage.read_stop_table(out)``.
     method : {"rkf45", "radau5", "auto"} or None, default None
-        The integrator; None means "rkf45" (the paper's scheme) at a fixed n and "auto"
-        (chosen per case) with ``n="auto"``.
+        The integrator; None: "auto" (chosen per case, ``refinement.auto_method``) with
+        ``n="auto"`` and "rkf45" (the paper's) at a fixed n.
     t_end : float, default 10.0
         Final time, in t_u (docs/model.md, "Units").
     rtol : float, default 1e-6
@@ -149,27 +149,30 @@ def sweep(g0, theta0_deg, out, *, n="auto", seeds=1, method=None, t_end=DEFAULT_
     perturbation : float, default 1e-3
         RMS size of the seeded initial perturbation, in L/2π (0: the exact circle).
     twin : bool, default True
-        Run each case's twin at 10x stricter tolerances, which says whether its outcome is
-        ``determined`` (about doubles the cost).
+        Also run the twin at 10x stricter tolerances that says whether the outcome is
+        ``determined`` (``loopsim.outcomes``); run and twin together cost about 2.7x the
+        run alone (docs/auto-and-determinacy.md).
     early_stop : bool, default True
         Stop a case once its shape and tilt are steady (docs/sweeps.md).
     n_max : int, default 32
-        With ``n="auto"``: the highest order a case may reach.
+        With ``n="auto"``: the highest order a run may reach (also capped by the model's,
+        for nonlocal).
     tail_tol : float, default 1e-5
-        With ``n="auto"``: the spectral-tail tolerance (dimensionless) that restarts a
-        case at the next order.
+        With ``n="auto"``: the spectral-tail tolerance (dimensionless) that restarts a run
+        at the next order.
     model : {"local", "nonlocal"}, default "local"
         The hydrodynamics: the paper's local slender-body theory, or full slender-body
-        theory (needs ``slenderness``; docs/nonlocal.md).
+        theory (needs ``slenderness``; docs/nonlocal.md), whose n must stay below its
+        highest order (``models.highest_order``).
     slenderness : float or None, default None
         With ``model="nonlocal"``: ε = a/L, filament radius over loop length
         (dimensionless, in (0, 0.05]).
     max_steps : int, default 2000000
-        Most time steps per case.
+        Most time steps of a run.
     length_tol : float, default 0.25
-        Relative length error (dimensionless) at which a case stops as failed.
+        Relative length error (dimensionless) at which a run stops as failed.
     steady_interval : float, default 0.5
-        Interval of the steady-state test of the early stop, in t_u.
+        Interval of the steady-state test (``steady_tol``), in t_u.
     steady_tol : float, default 1e-6
         Change per interval (dimensionless) below which the state is steady.
     thresholds : loopsim.outcomes.Thresholds, default Thresholds()
