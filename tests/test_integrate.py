@@ -148,7 +148,7 @@ def test_radau_fixed_step_order():
             R.newton_matrices(jac, h, lu_r, piv_r, lu_c, piv_c)
             z[:] = 0.0
             for _ in range(20):  # restart from the last iterate until tightly converged
-                converged, *_ = R.solve_collocation(problem, y, h, z, np.full(n, 1e-14), 1e-2, R.NEWTON_MAXITER,
+                converged, *_ = R.solve_collocation(problem, y, h, z, np.full(n, 1e-14), 1e-2, 0.0, R.NEWTON_MAXITER,
                                                       lu_r, piv_r, lu_c, piv_c, w, fz, work_y,
                                                       real_rhs, complex_rhs)
                 if converged:

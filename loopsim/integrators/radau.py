@@ -29,8 +29,8 @@ steps at which it no longer contracts (at (150, 45°, 16), t ≤ 2, rtol 1e-3,
 295 of 298 rejections were Newton failures, most followed by a half step, a
 doubling and the same failure), so the step grows at most to where the
 contraction rate is predicted to reach NEWTON_RATE_TARGET, and not at all
-right after a rejection (Hairer).  Only rates measured from a correction above the
-Newton tolerance count for that limit: below it the corrections are rounding noise,
+right after a rejection (Hairer).  Only rates measured from a correction well above
+its rounding count for that limit (NOISE_MARGIN): nearer, the corrections are noise,
 whose ratio (0.3-0.6 near a steady state at rtol 1e-9) would shrink h at every step
 (rtol 1e-9, atol 1e-12 then cost 4.2x rtol 1e-8 at (150, 45°, 21), t <= 10).  The error
 weights atol + rtol |y_i| are floored at the rounding error a Newton correction carries,
@@ -88,8 +88,11 @@ REJECTED_GROWTH = 1.0
 #: every h), and the iteration must see it below its tolerance newton_tol (in units of the
 #: weights).  With the floor at 100 eps h max|f| instead, rtol 1e-10, atol 1e-13 rejected
 #: 18 319 steps for 40 207 accepted over t <= 10, all Newton failures in the noise; with
-#: this floor, 57 for 8 204, at the same terminal tilt to 2e-7 deg.
+#: this floor, 36 for 8 178, at the same terminal tilt to 2e-7 deg.
 ROUNDOFF_FLOOR = 1.0
+#: A contraction rate counts for the Newton limit only when measured from a correction
+#: above NOISE_MARGIN times the corrections' rounding (:func:`rounding_noise`).
+NOISE_MARGIN = 10.0
 
 #: The method as data: its error order and the policy constants above.
 RadauIIA = collections.namedtuple(
@@ -165,14 +168,15 @@ def newton_matrices(jac, h, lu_real, piv_real, lu_complex, piv_complex):
 
 
 @kernel
-def solve_collocation(problem, y, h, z, scale, tol, maxiter, lu_real, piv_real, lu_complex,
-                      piv_complex, w, fz, stage, real_rhs, complex_rhs):
+def solve_collocation(problem, y, h, z, scale, tol, noise, maxiter, lu_real, piv_real,
+                      lu_complex, piv_complex, w, fz, stage, real_rhs, complex_rhs):
     """Simplified Newton for Z = h A F(y + Z), from the guess in z (3, n), updated in place.
 
     Returns (converged, iterations, rate, limit_rate); 3 RHS evaluations per iteration.
     ``rate`` is the last contraction rate seen; ``limit_rate`` the last one measured from
-    a correction above ``tol`` (-1 if none): below ``tol`` the corrections are at the
-    iteration's noise, and their ratio says nothing of how h affects convergence.
+    a correction above NOISE_MARGIN times ``noise`` (the corrections' rounding, in the
+    norm of ``scale``; -1 if none): nearer the noise, the ratio of two corrections says
+    nothing of how h affects convergence.
     """
     n = y.shape[0]
     m_real = MU_REAL / h
@@ -207,7 +211,7 @@ def solve_collocation(problem, y, h, z, scale, tol, maxiter, lu_real, piv_real, 
         norm = np.sqrt(acc / (3 * n))
         if norm_old >= 0.0:
             rate = norm / norm_old
-            if norm_old > tol:
+            if norm_old > NOISE_MARGIN * noise:
                 limit_rate = rate
         if rate >= 0.0 and (rate >= 1.0 or
                             rate ** (maxiter - iteration) / (1.0 - rate) * norm > tol):
@@ -273,6 +277,16 @@ def step_proposal(method, controller, safety, rate, rejected, recompute_jac):
 
 
 @kernel
+def rounding_noise(h, f_max, scale):
+    """eps h max|f| in the RMS norm weighted by ``scale``: the size of the rounding a
+    Newton correction carries (about 0.3 of it, measured)."""
+    acc = 0.0
+    for i in range(scale.shape[0]):
+        acc += (1.0 / scale[i]) ** 2
+    return EPS * h * f_max * np.sqrt(acc / scale.shape[0])
+
+
+@kernel
 def error_weights(y, y_new, rtol, atol, floor, scale):
     """scale_i = max(atol + rtol max(|y_i|, |y_new_i|), floor) (``y_new`` may be ``y``)."""
     for i in range(y.shape[0]):
@@ -319,6 +333,7 @@ def _radau_attempt(method, work, problem, y, f, h, y_new, options):
         f_max = max(f_max, abs(f[i]))
     floor = method.roundoff_floor * EPS * h * f_max / s[NEWTON_TOL]
     error_weights(y, y, options.rtol, options.atol, floor, work.scale)
+    noise = rounding_noise(h, f_max, work.scale)
     evals = 0
     while True:
         if h != s[H_LU]:
@@ -331,7 +346,7 @@ def _radau_attempt(method, work, problem, y, f, h, y_new, options):
         else:
             work.z[:] = 0.0
         converged, iterations, rate, limit_rate = solve_collocation(
-            problem, y, h, work.z, work.scale, s[NEWTON_TOL], method.newton_maxiter,
+            problem, y, h, work.z, work.scale, s[NEWTON_TOL], noise, method.newton_maxiter,
             work.lu_real, work.piv_real, work.lu_complex, work.piv_complex, work.w, work.fz,
             work.work_y, work.real_rhs, work.complex_rhs)
         evals += 3 * iterations
