@@ -4,6 +4,7 @@ the shape, the nonlocal one's (``nonlocal_maps.nonlocal_jacobian``)."""
 import numpy as np
 
 from ..jit import kernel
+from ..linalg import solve
 from .loop_maps import loop_velocity_blocks
 
 
@@ -140,7 +141,7 @@ def mobility_jacobian(w, isotropic, along, nonlocal_share, weight, direction, po
     if weight is not None:
         add_kernel_shape_adjoint(nonlocal_share, weight, direction, inverse, t, rho, ws.force,
                                  S0, S1, rhs_t)
-    dtau = -np.linalg.solve(np.dot(a.T, a), rhs_t)  # (K, D)
+    dtau = -solve(np.dot(a.T, a), rhs_t)  # (K, D): np.linalg.solve's gesv, bit for bit
     # δu = F (δm + m_T δT), then arrange as J[(c', k'), (c, k)]
     m_t = np.empty((m * 3, k))
     for i in range(m):
