@@ -301,7 +301,7 @@ def _scaled_normal_residual(block, scale, tau, residual, out):
         out[j] *= -scale[j]
 
 
-@kernel
+@kernel(inline=True)
 def least_squares_normal(block, scale, out, gram, residual, correction):
     """Solve min_τ ||A τ + b||₂ (block as in :func:`least_squares_affine`, not destroyed)
     by Björck's corrected semi-normal equations on the column-scaled problem:

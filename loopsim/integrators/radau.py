@@ -174,7 +174,7 @@ def newton_matrices(jac, h, lu_real, piv_real, lu_complex, piv_complex):
     lu_factor(lu_complex, piv_complex)
 
 
-@kernel
+@kernel(inline=True)  # in the step attempt: a library of its own would hold the rhs again
 def solve_collocation(problem, y, h, z, scale, tol, maxiter, lu_real, piv_real, lu_complex,
                       piv_complex, w, fz, stage, real_rhs, complex_rhs):
     """Simplified Newton for Z = h A F(y + Z), from the guess in z (3, n), updated in place.

@@ -17,7 +17,7 @@ def loop_jacobian(x, g0, w, ops, ws, jac):
     mobility_jacobian(w, 1.0, 1.0, 0.0, None, None, None, ops, ws, jac)
 
 
-@kernel
+@kernel(inline=True)  # in its callers: a library of its own would compile it once more
 def mobility_jacobian(w, isotropic, along, nonlocal_share, weight, direction, position, ops,
                       ws, jac):
     """J = ∂u/∂x (3K × 3K, component-major) of the loop velocity with mobility
