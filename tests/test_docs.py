@@ -25,7 +25,47 @@ def test_docs_build_strict(tmp_path):
     assert (site / "index.html").is_file()
     api = site / "api" / "index.html"
     assert api.is_file()
-    assert "simulate" in api.read_text(encoding="utf-8")
+    html = api.read_text(encoding="utf-8")
+    assert "simulate" in html
+    assert not sphinx_roles(html), sphinx_roles(html)
+    internal = [name for name in api_objects(html) if not api_object_is_public(name)]
+    assert not internal, internal
+
+
+#: A Sphinx role as MkDocs renders it: literally (mkdocstrings reads Markdown, not reST).
+SPHINX_ROLE = re.compile(r":(?:func|class|meth|data|mod|attr|exc|obj|py:\w+):(?:<code>|`)")
+#: What the API page documents besides loopsim.__all__ and SimulationResult's members:
+#: the modules whose docstrings define the results' terms (their functions are internal),
+#: the thresholds a result carries, and the stop table of --seeds auto.
+API_EXTRAS = ("loopsim.seeding", "loopsim.outcomes", "loopsim.outcomes.Thresholds",
+              "loopsim.columns", "loopsim.refinement", "loopsim.io.read_stop_table")
+
+
+def sphinx_roles(html):
+    return SPHINX_ROLE.findall(html)
+
+
+def api_objects(html):
+    """The objects of a built API page (mkdocstrings' headings), by full name."""
+    return re.findall(r'<h\d id="([^"]+)" class="doc doc-heading"', html)
+
+
+def api_object_is_public(name):
+    import loopsim
+
+    return (name.rsplit(".", 1)[-1] in loopsim.__all__ or name in API_EXTRAS
+            or name.startswith("loopsim.result.SimulationResult."))
+
+
+def test_the_api_page_checks_catch_what_they_are_for():
+    """As the page rendered: a role in a docstring, and a module's internal functions."""
+    assert sphinx_roles("<p>see :func:<code>simulate</code>, :data:`SAME`.</p>") == [
+        ":func:<code>", ":data:`"]
+    html = ('<h2 id="loopsim.api.simulate" class="doc doc-heading">'
+            '<h3 id="loopsim.seeding.widths" class="doc doc-heading">'
+            '<h3 id="loopsim.result.SimulationResult.summary" class="doc doc-heading">')
+    assert [n for n in api_objects(html) if not api_object_is_public(n)] == [
+        "loopsim.seeding.widths"]
 
 
 # ---------------------------------------------------------------------------------
