@@ -94,3 +94,18 @@ def test_the_top_level_examples_include_the_readme_main_job():
     assert " ".join(shlex.quote(w) for w in main_command()) in epilog
     assert "--n 6 --method rkf45" in epilog  # the paper's scheme, one flag away
     assert "--out runs/phase_n6" in epilog and "--n 6 --method rkf45 --out runs/phase " not in epilog
+
+def test_summary_figure_help_says_what_the_figure_draws():
+    """The figure's first panel is ``probability_phase_diagram`` in its default style:
+    pies of the regime probabilities (P(3D) alone is its "colour" style)."""
+    import inspect
+
+    from loopsim.figures import distributions
+
+    source = inspect.getsource(distributions.distribution_summary)
+    assert "probability_phase_diagram(cells, ax=axes[0])" in source  # the default style
+    style = inspect.signature(distributions.probability_phase_diagram).parameters["style"]
+    action = next(a for a in subcommands(cli.build_parser())["summary"]._actions
+                  if "--figure" in a.option_strings)
+    assert style.default == "pie" and "pie" in action.help and "P(3D)" not in action.help
+

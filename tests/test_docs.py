@@ -283,3 +283,54 @@ def test_the_n6_grid_and_the_main_job_have_one_name_each():
         text = page_text(name)
         assert not re.search(r"main job \(n = 6\)|main job's curve|former main job"
                              r"|main-job grid|Main job:", text), name
+
+
+def tension_solve_sentence(text):
+    """The model page's sentence on how T is solved for (from "T minimises" to its end)."""
+    flat = " ".join(text.split())
+    return re.search(r"T minimises.*?\.(?: |$)", flat).group(0).strip()
+
+
+def test_the_model_page_names_the_tension_solve_the_velocity_runs():
+    """docs/model.md names the solve ``loop_velocity`` calls: linalg's Cholesky on the
+    normal equations first, its QR only when that fails (it once said "Householder least
+    squares" for all of it)."""
+    import inspect
+
+    from loopsim import linalg
+    from loopsim.models import loop_maps
+
+    source = inspect.getsource(loop_maps.loop_velocity)
+    calls = [source.index(name) for name in ("least_squares_normal", "least_squares_affine")]
+    assert calls == sorted(calls)  # normal equations first, QR as the fallback
+    assert "Cholesky" in linalg.least_squares_normal.__doc__
+    assert "QR" in linalg.least_squares_affine.__doc__
+    sentence = tension_solve_sentence(page_text("model.md"))
+    assert 0 <= sentence.find("Cholesky") < sentence.find("QR"), sentence
+    assert "normal equations" in sentence
+
+
+def test_the_model_page_gives_each_symbol_one_meaning():
+    """ε is the slenderness a/L there; the length creation has a symbol of its own."""
+    text = page_text("model.md")
+    slenderness = re.search(r"(\S+) = a/L", text).group(1)
+    creation = re.search(r"length creation (\S+)", text).group(1)
+    assert creation != slenderness
+    assert f"∫{slenderness}²" not in text
+
+
+def test_the_model_page_checks_catch_the_old_text():
+    old = ("length creation ε kept to order 2n;\n  T minimises ∫ε² ds (Householder least "
+           "squares on a 4n+1 point grid, which\n  resolves ε exactly).\n")
+    assert "Cholesky" not in tension_solve_sentence(old)
+    assert re.search(r"length creation (\S+)", old).group(1) == "ε"
+
+
+def test_no_page_says_the_summary_figure_draws_p3d_alone():
+    """The summary's figure (``loopsim summary --figure``, ``sweep --seeds auto --figure``)
+    draws a pie of the regime probabilities per cell, not P(3D)."""
+    claim = re.compile(r"--figure`? (?:draws?|also draws?) P\(3D\)|draw P\(3D\) per")
+    assert claim.search("`--figure` draws P(3D) per point and")
+    found = {name: claim.findall(" ".join(page_text(name).split())) for name in pages()}
+    assert not {name: hits for name, hits in found.items() if hits}
+
