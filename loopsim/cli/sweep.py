@@ -3,6 +3,7 @@ when re-run; also reruns of a sweep's failed cases (``--rerun-failed``)."""
 import math
 import sys
 
+from ..columns import CASE_COLUMNS, CASE_OVERRIDES
 from ..config import DEFAULT_AUTO_CHUNK_SIZE, DEFAULT_CHUNK_SIZE, DEFAULT_N, SEED_TARGETS
 from .common import (
     EXIT_FAILED_RUN, HelpFormatter, Parser, add_integration_options, check_auto_options,
@@ -55,10 +56,11 @@ def add_parser(commands):
     grid.add_argument("--seeds", default="1", metavar="K|auto",
                       help="seeds 0..K-1 per point, or auto: per point 4, 8, 16 ... seeds "
                       "until its answer is sharp (see --p-halfwidth; docs/distributions.md)")
-    grid.add_argument("--cases", metavar="FILE", help="CSV/Parquet with columns g0, theta0_deg "
-                      "[, n, seed, perturbation, initial, initial_case_id] instead of a grid "
-                      "(initial: a point file or results per row, paths relative to FILE; "
-                      "theta0_deg then left empty)")
+    grid.add_argument("--cases", metavar="FILE", help="CSV/Parquet with columns "
+                      f"{', '.join(CASE_COLUMNS[:2])} [, {', '.join(CASE_COLUMNS[2:])}] "
+                      "instead of a grid, one row per case (initial: a point file or results "
+                      "per row, paths relative to FILE, theta0_deg then left empty; "
+                      f"{', '.join(CASE_OVERRIDES)}: that row's own option)")
     integration = sweep.add_argument_group("integration of each case")
     add_integration_options(integration)
     integration.add_argument("--no-early-stop", action="store_true",

@@ -10,6 +10,7 @@ import numpy as np
 import pandas as pd
 
 from .. import integrators, models, refinement, shapes, validation
+from ..columns import CASE_COLUMNS, CASE_OVERRIDES  # declared with the other columns
 from ..config import (
     DEFAULT_ATOL, DEFAULT_CHUNK_SIZE, DEFAULT_LENGTH_TOL, DEFAULT_MAX_STEPS, DEFAULT_N_MAX,
     MODEL_CHOICES,
@@ -119,13 +120,6 @@ def _cell(path, row, column, value, integer):
                              f"integer, got {value!r}")
         return int(number)
     return number
-
-
-#: Optional per-case columns of a cases file that override the sweep's option.
-CASE_OVERRIDES = ("method", "rtol", "t_end", "model", "slenderness")
-#: Every column a cases file may have.
-CASE_COLUMNS = ("g0", "theta0_deg", "n", "seed", "perturbation", "initial",
-                "initial_case_id") + CASE_OVERRIDES
 
 
 def _check_case_columns(path, names):
