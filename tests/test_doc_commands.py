@@ -205,3 +205,26 @@ def test_the_checks_catch_what_they_are_for():
     assert command_errors(["summary", "DIR", "[--outt", "FILE]"]) == [
         "summary has no option --outt"]
     assert command_errors(["frobnicate"]) == ["no command 'frobnicate'"]
+
+
+def test_the_compilation_table_names_what_its_run_runs():
+    """docs/performance.md times ``loopsim run`` commands: each row names the integrator
+    the command runs (it once said "rkf45 at n = 6" for a run that is --n auto, radau5)."""
+    from loopsim import refinement
+    from loopsim.diagnostics import stability_parameter
+
+    with open(os.path.join(DOCS, "performance.md"), encoding="utf-8") as handle:
+        section = handle.read().split("## Compilation", 1)[1].split("\n## ", 1)[0]
+    rows = [line for line in section.splitlines() if line.startswith("| `loopsim run ")]
+    assert rows
+    for row in rows:
+        (words,) = [shlex.split(c)[1:] for c in re.findall(r"`(loopsim run [^`]*)`", row)]
+        args = cli.build_parser().parse_args(words)
+        method = args.method or ("auto" if args.n == "auto" else "rkf45")
+        if method == "auto":
+            method = refinement.auto_method(stability_parameter(args.g0, args.theta0),
+                                            6 if args.n == "auto" else args.n, args.n == "auto")
+        others = set(refinement.METHOD_CHOICES) - {method, "auto"}
+        assert method in row and not any(other in row for other in others), row
+        assert ("--n auto" in row) == (args.n == "auto"), row
+
