@@ -122,7 +122,7 @@ class CompileClock(numba.core.event.Listener):
     without it (``seconds`` before and after, subtracted)."""
 
     NOTICE = ("loopsim: compiling numerical kernels for first use (cached for later runs; "
-              "about 20 s for a run, a minute for a sweep, on 2 cores) ...")
+              "most of a minute on 2 idle cores, longer on busy ones) ...")
 
     def __init__(self):
         self.seconds = 0.0

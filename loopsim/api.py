@@ -58,7 +58,7 @@ def evaluate_maps(x, g0, w=DEFAULT_W, *, model="local", slenderness=None):
     w : float, default 10.0
         Length-penalty rate, in 1/t_u.
     model : {"local", "nonlocal"}, default "local"
-        The hydrodynamics (as in :func:`simulate`).
+        The hydrodynamics (as in ``simulate``).
     slenderness : float or None, default None
         With ``model="nonlocal"``: ε = a/L (dimensionless).
 
@@ -217,9 +217,12 @@ def simulate(
     Examples
     --------
     >>> import loopsim
-    >>> result = loopsim.simulate(150, 45)  # doctest: +SKIP
-    >>> result.resolved, result.n_used, result.regime  # doctest: +SKIP
-    >>> paper = loopsim.simulate(150, 45, n=6, method="rkf45")  # doctest: +SKIP
+    >>> result = loopsim.simulate(60, 30)  # n="auto": up the ladder, radau5, with its twin
+    >>> result.regime, result.resolved, result.determined, result.n_used, result.method
+    ('in-plane', True, True, 16, 'radau5')
+    >>> paper = loopsim.simulate(20, 30, n=6, method="rkf45")  # the paper's scheme
+    >>> paper.regime, paper.resolved, paper.determined
+    ('stable', True, True)
     """
     g0 = validation.check_real("g0", g0, low=0.0)
     model = models.choose(model, slenderness)

@@ -239,6 +239,16 @@ CONVERGENCE_COLUMNS = {
 }
 
 
+#: Optional per-case columns of a cases file (``sweep --cases``) that override the sweep's
+#: option for that row (each is also a result column).
+CASE_OVERRIDES = ("method", "rtol", "t_end", "model", "slenderness")
+#: Every column a cases file may have: g0 and theta0_deg (empty for a row that starts from
+#: its ``initial`` file), then the optional ones (``sweeps.read_cases_file``; docs/sweeps.md
+#: lists them from here).
+CASE_COLUMNS = ("g0", "theta0_deg", "n", "seed", "perturbation", "initial",
+                "initial_case_id") + CASE_OVERRIDES
+
+
 def field_metadata(name, table=RESULT_COLUMNS):
     """Parquet field metadata of a column: {b"unit": ..., b"description": ...}."""
     unit, description = table[name]

@@ -48,8 +48,10 @@ class Kernel:
     Python through a trampoline; other attributes (``py_func``, ``signatures``,
     ``inspect_llvm``...) are the dispatcher's."""
 
-    def __init__(self, function):
-        self.dispatcher = numba.njit(**KERNEL_JIT)(function)
+    def __init__(self, function, inline=False):
+        options = dict(KERNEL_JIT, inline="always") if inline else KERNEL_JIT
+        self.dispatcher = numba.njit(**options)(function)
+        self.inline = inline
         self._from_python = None
         functools.update_wrapper(self, function)
 
@@ -61,6 +63,8 @@ class Kernel:
         if self._from_python is None:
             TRAMPOLINES.append(f"{self.__module__}.{self.__qualname__}")
             target = self.dispatcher
+            if self.inline:  # a trampoline cannot take an inline kernel's code: call a copy
+                target = numba.njit(**dict(KERNEL_JIT, cache=False))(self.py_func)
             self._from_python = numba.njit(nogil=True, error_model="numpy")(
                 lambda *arguments: target(*arguments))
         return self._from_python(*args)
@@ -86,7 +90,17 @@ def _kernel_by_name(module, qualname):
     return found
 
 
-def kernel(function):
+def kernel(function=None, *, inline=False):
     """Compile ``function`` as a kernel: called from jitted code (from Python only in tests
-    and interactive use, through a trampoline)."""
-    return Kernel(function)
+    and interactive use, through a trampoline).
+
+    ``@kernel(inline=True)``: jitted callers take the function's code into their own
+    (Numba's ``inline="always"``, before typing) instead of calling it, so it has no
+    library of its own.  For a large kernel with one or two callers: every library that
+    calls another links in and compiles again all the code below it, so a kernel between
+    two big ones costs a compilation of everything under it (docs/performance.md,
+    "Compilation").  The arithmetic is the same operations either way (no fastmath), so
+    results do not change."""
+    if function is None:
+        return lambda function: Kernel(function, inline=inline)
+    return Kernel(function, inline=inline)

@@ -1,5 +1,6 @@
 """Dense linear algebra in Numba: LAPACK's LU (implicit integrators), QR and Cholesky
-(tension solve), and BLAS's matrix product by blocks.
+(tension solve), gesv (the exact Jacobian's tension derivative), and BLAS's matrix
+product by blocks.
 
 The factorisations, the O(n³) parts, are scipy's LAPACK getrf and geqrf,
 reached through the ``numba_xxgetrf`` and ``numba_ez_geqrf`` wrappers that
@@ -135,6 +136,50 @@ def least_squares_affine(block, out, tau):
         out[i] = acc / block[i, i]
 
 
+#: numba_xgesv(kind, n, nrhs, a, lda, ipiv, b, ldb) -> info: LAPACK's gesv, the routine
+#: ``np.linalg.solve`` calls in compiled code (Numba's helper library), real only.
+_GESV = types.ExternalFunction("numba_xgesv", types.intc(
+    types.char, types.intp, types.intp, types.CPointer(types.float64), types.intp,
+    types.CPointer(F_INT_nbtype), types.CPointer(types.float64), types.intp))
+
+
+@kernel
+def solve(a, b):
+    """``np.linalg.solve(a, b)`` for a (n, n) and b (n, r), both 2-D float64: the same
+    LAPACK call (gesv) on the same column-major copies, so the same solution bit for bit,
+    returned as Numba's is (column-major, (n, r)), with the same errors.
+
+    Without Numba's version, whose copy of b is a slice assignment: its broadcasting
+    check's error message compiles string formatting code, and every library holding the
+    exact Jacobian held it (docs/performance.md, "Compilation").
+    """
+    n = a.shape[0]
+    nrhs = b.shape[1]
+    if a.shape[1] != n or b.shape[0] != n:
+        raise np.linalg.LinAlgError("solve: incompatible dimensions")
+    for i in range(n):
+        for j in range(n):
+            if not np.isfinite(a[i, j]):
+                raise np.linalg.LinAlgError("Array must not contain infs or NaNs.")
+    for i in range(n):
+        for j in range(nrhs):
+            if not np.isfinite(b[i, j]):
+                raise np.linalg.LinAlgError("Array must not contain infs or NaNs.")
+    acpy = np.empty((n, n)).T
+    bcpy = np.empty((nrhs, n)).T
+    for j in range(n):
+        for i in range(n):
+            acpy[i, j] = a[i, j]
+    for j in range(nrhs):
+        for i in range(n):
+            bcpy[i, j] = b[i, j]
+    ipiv = np.empty(n, dtype=PIVOT_DTYPE)
+    info = _GESV(_REAL, n, nrhs, acpy.ctypes, n, ipiv.ctypes, bcpy.ctypes, n)
+    if info != 0:
+        raise np.linalg.LinAlgError("Matrix is singular to machine precision.")
+    return bcpy
+
+
 #: numba_xxpotrf(kind, uplo, n, a, lda) -> info, real only (Cholesky).
 _POTRF = types.ExternalFunction("numba_xxpotrf", types.intc(
     types.char, types.char, types.intp, types.CPointer(types.float64), types.intp))
@@ -255,7 +300,7 @@ def _scaled_normal_residual(block, scale, tau, residual, out):
         out[j] *= -scale[j]
 
 
-@kernel
+@kernel(inline=True)
 def least_squares_normal(block, scale, out, gram, residual, correction):
     """Solve min_τ ||A τ + b||₂ (block as in :func:`least_squares_affine`, not destroyed)
     by Björck's corrected semi-normal equations on the column-scaled problem:

@@ -137,7 +137,7 @@ def summarize(frame, by=None, seed=0):
     """Outcomes as distributions: one row per cell of a results table, from its seeds.
 
     A cell is one point of the sweep's inputs with the seed left out: ``g0``,
-    ``theta0_deg`` and every other input of :data:`CELL_INPUTS` that takes more than one
+    ``theta0_deg`` and every other input of ``CELL_INPUTS`` that takes more than one
     value in the table.  A cell holds each seed at most once (two rows with one seed
     differ in an input the table does not record, such as an ``initial`` shape, and are
     refused rather than merged).
@@ -145,10 +145,10 @@ def summarize(frame, by=None, seed=0):
     Parameters
     ----------
     frame : pandas.DataFrame
-        A results table (:func:`loopsim.read_results`), with at least ``regime``,
+        A results table (``loopsim.read_results``), with at least ``regime``,
         ``resolved``, ``determined`` and the cell columns.
     by : list of str or None, default None
-        The columns that define the cells; None: :func:`cell_columns` (g0, theta0_deg and
+        The columns that define the cells; None: ``cell_columns`` (g0, theta0_deg and
         every other input that varies).
     seed : int, default 0
         Seed of the bootstrap's generator (the table is reproducible bit for bit).
@@ -170,7 +170,7 @@ def summarize(frame, by=None, seed=0):
           (p̂ + z²/2N ± z sqrt(p̂(1 − p̂)/N + z²/4N²)) / (1 + z²/N), z = Φ⁻¹(0.975);
         * the quartiles of the terminal tilt (degrees), aspect ratio and q
           (``tilt_*``, ``aspect_*``, ``q_final_*``), each median with a 95 %
-          percentile-bootstrap interval (:data:`BOOTSTRAP_RESAMPLES` resamples);
+          percentile-bootstrap interval (``BOOTSTRAP_RESAMPLES`` resamples);
         * the cost: ``nfev``, ``twin_nfev`` and ``wall_s`` (seconds) summed.
 
         ``table.attrs["loopsim_summary"]`` records the cell columns and the bootstrap.
@@ -183,10 +183,13 @@ def summarize(frame, by=None, seed=0):
 
     Examples
     --------
+    Four seeds of one cell (docs/distributions.md summarises 16 seeds of four):
+
     >>> import loopsim
-    >>> rows = loopsim.read_results("runs/seeds")  # doctest: +SKIP
-    >>> loopsim.summarize(rows)[["g0", "theta0_deg", "seeds", "p_3d", "p_3d_low",
-    ...                          "p_3d_high", "tilt_median"]]  # doctest: +SKIP
+    >>> rows = loopsim.sweep(40.0, 30.0, "runs/four", n=6, t_end=0.5, seeds=4, twin=False)
+    >>> loopsim.summarize(rows)[["g0", "theta0_deg", "seeds", "p_3d", "p_3d_high"]].round(3)
+         g0  theta0_deg  seeds  p_3d  p_3d_high
+    0  40.0        30.0      4   0.0       0.49
     """
     by = list(cell_columns(frame) if by is None else by)
     missing = [c for c in by if c not in frame]
@@ -305,17 +308,17 @@ def compare(a, b, by=None, alpha=0.05, seed=0, resamples=500):
     For each cell both tables hold (the same cells at, say, n = 24 and n = 32, or at two
     tolerances): two-sample Kolmogorov-Smirnov tests of the terminal tilt and aspect
     ratio, the tilt's 1-Wasserstein distance with a bootstrap interval, a chi-square test
-    of the regime counts, and a verdict: :data:`DIFFERENT` when any of the three p-values
-    is below alpha / 3 (Bonferroni), else :data:`SAME`.
+    of the regime counts, and a verdict: ``DIFFERENT`` when any of the three p-values
+    is below alpha / 3 (Bonferroni), else ``SAME``.
 
     Parameters
     ----------
     a, b : pandas.DataFrame
-        Results tables (:func:`loopsim.read_results`) with ``theta_final_deg``,
+        Results tables (``loopsim.read_results``) with ``theta_final_deg``,
         ``aspect_ratio``, ``regime`` and the pairing columns.
     by : list of str or None, default None
         The columns that pair the cells; None: g0, theta0_deg and every input of
-        :data:`CELL_INPUTS` that varies within either table.
+        ``CELL_INPUTS`` that varies within either table.
     alpha : float, default 0.05
         Significance level of the verdict (a probability, over the three tests).
     seed : int, default 0
@@ -338,10 +341,14 @@ def compare(a, b, by=None, alpha=0.05, seed=0, resamples=500):
 
     Examples
     --------
+    The same cell's seeds at two orders:
+
     >>> import loopsim
-    >>> a = loopsim.read_results("runs/seeds_n24")  # doctest: +SKIP
-    >>> b = loopsim.read_results("runs/seeds_n32")  # doctest: +SKIP
-    >>> loopsim.compare(a, b)[["g0", "theta0_deg", "tilt_ks_p", "verdict"]]  # doctest: +SKIP
+    >>> a = loopsim.sweep(40.0, 30.0, "runs/n6", n=6, t_end=0.5, seeds=4, twin=False)
+    >>> b = loopsim.sweep(40.0, 30.0, "runs/n8", n=8, t_end=0.5, seeds=4, twin=False)
+    >>> loopsim.compare(a, b)[["g0", "theta0_deg", "tilt_ks_p", "verdict"]]
+         g0  theta0_deg  tilt_ks_p                                verdict
+    0  40.0        30.0        1.0  indistinguishable at this sample size
     """
     from scipy.stats import chi2_contingency, ks_2samp
 

@@ -4,7 +4,7 @@ whether its terminal outcome is *determined*.
 Determinacy.  A 3D transient can amplify small errors so much that its terminal
 tilt is a sample of an ill-conditioned transient rather than an outcome of the
 inputs.  Every case is therefore run twice from the same start: the run itself,
-and a *twin* with every tolerance :data:`TWIN_FACTOR` times stricter (rtol, atol
+and a *twin* with every tolerance ``TWIN_FACTOR`` times stricter (rtol, atol
 and, with ``n="auto"``, the spectral-tail tolerance).  When both runs converge,
 the twin's error is about a tenth of the run's, so their difference estimates the
 run's own error at the tolerances used::
@@ -35,18 +35,25 @@ TWIN_FACTOR = 10.0
 
 @dataclasses.dataclass(frozen=True)
 class Thresholds:
-    """Regime, resolution and determinacy thresholds.
+    """Regime, resolution and determinacy thresholds (``SimulationResult.thresholds``;
+    stored in a sweep's table metadata).
 
-    tilt_change_deg: |θ_final − θ0| above which the tilt has changed (3d).
-    shape_change: |aspect ratio_final − aspect ratio_initial| above which the shape has
-    (in-plane; paper §6: stable = shape and tilt unchanged).
-    resolved_length_error, resolved_tail: a case is resolved at its n when its worst
-    transient relative length error and its largest spectral tail along the run stay at
-    or below these (``defaults.RESOLVED_LENGTH_ERROR``, ``defaults.RESOLVED_TAIL``).
-    determined_tilt_deg, determined_aspect: the largest run–twin differences of a
-    determined case (module docstring): a fifth of the accuracy users ask of a
-    terminal state (0.05 deg, 1e-3), so that the run's error, about the difference,
-    stays well inside it.
+    Attributes
+    ----------
+    tilt_change_deg : float, default 1.0
+        |θ_final − θ0| (degrees) above which the tilt has changed: regime 3d.
+    shape_change : float, default 0.01
+        |aspect ratio_final − aspect ratio_initial| above which the shape has changed:
+        regime in-plane (paper §6: stable = shape and tilt unchanged).
+    resolved_length_error, resolved_tail : float
+        A case is resolved at its n when its worst transient relative length error and
+        its largest spectral tail along the run stay at or below these
+        (``defaults.RESOLVED_LENGTH_ERROR``, ``defaults.RESOLVED_TAIL``).
+    determined_tilt_deg, determined_aspect : float, default 0.01 and 2e-4
+        The largest run–twin differences (degrees; aspect ratio) of a determined case
+        (module docstring): a fifth of the accuracy users ask of a terminal state
+        (0.05 deg, 1e-3), so that the run's error, about the difference, stays well
+        inside it.
     """
 
     tilt_change_deg: float = 1.0

@@ -19,12 +19,12 @@ FAILED, REACHED_END, STOPPED_EARLY = -1, 0, 1
 
 @dataclasses.dataclass(repr=False)
 class SimulationResult:
-    """One trajectory of :func:`simulate`: inputs, states at the requested times, the final
+    """One trajectory of ``simulate``: inputs, states at the requested times, the final
     state, the outcome and the cost.
 
     Coefficient arrays are real cos/sin coefficients [a0, a1..an, b1..bn] per component
     (``loopsim.spectral``); lengths in L/2π, times in t_u, forces in EI (2π/L)²
-    (docs/model.md, "Units").  Returned by :func:`simulate`, not built by hand.
+    (docs/model.md, "Units").  Returned by ``simulate``, not built by hand.
 
     Attributes
     ----------
@@ -42,7 +42,7 @@ class SimulationResult:
         (k, 3, 2 n_used + 1) velocity coefficients at ``t``, in (L/2π)/t_u.
     multiplier : numpy.ndarray
         (k, 2 n_used + 1) coefficients of the tension multiplier T at ``t``, in
-        EI (2π/L)²; the axial force is N = T + |x''|² (:meth:`tension_profile`).
+        EI (2π/L)²; the axial force is N = T + |x''|² (``tension_profile``).
     t_missed : numpy.ndarray
         The requested times not reached (an early stop or a failure), in t_u.
     t_final : float
@@ -96,9 +96,9 @@ class SimulationResult:
     Examples
     --------
     >>> import loopsim
-    >>> result = loopsim.simulate(60, 30, n=6, t_span=(0, 1), twin=False)  # doctest: +SKIP
-    >>> result.regime, result.resolved, result.x_final.shape  # doctest: +SKIP
-    ('stable', True, (3, 13))
+    >>> result = loopsim.simulate(60, 30, twin=False)
+    >>> result.regime, result.resolved, result.n_used, result.x_final.shape
+    ('in-plane', True, 16, (3, 33))
     """
 
     inputs: dict
@@ -246,8 +246,8 @@ def terminal_summary(inputs, x, u, multiplier, **run_stats):
 class LoopsimWarning(UserWarning):
     """A result that needs care: not resolved at its n, or not determined by its twin.
 
-    :func:`simulate` issues one per line of ``SimulationResult.warnings()``; filter them
-    with the standard :mod:`warnings` machinery.
+    ``simulate`` issues one per line of ``SimulationResult.warnings()``; filter them
+    with the standard ``warnings`` machinery.
 
     Examples
     --------
@@ -255,7 +255,7 @@ class LoopsimWarning(UserWarning):
     >>> import loopsim
     >>> with warnings.catch_warnings():
     ...     warnings.simplefilter("error", loopsim.LoopsimWarning)
-    ...     result = loopsim.simulate(150, 60, n=6)  # doctest: +SKIP
+    ...     result = loopsim.simulate(150, 60, n=6, twin=False)
     Traceback (most recent call last):
-    loopsim.api.LoopsimWarning: not resolved at n = 6 ...
+    loopsim.result.LoopsimWarning: not resolved at n = 6 ...
     """

@@ -13,7 +13,7 @@ seeds and doubles them, round after round, until one of these holds, checked in 
   at most ``tilt_halfwidth_deg``;
 * ``cap``: the cell has ``max_seeds`` seeds.
 
-A cell whose runs are *samples* (:func:`runs_are_samples`: some run succeeded, and its
+A cell whose runs are *samples* (``runs_are_samples``: some run succeeded, and its
 seeds end in different regimes, or some run's stricter twin ends elsewhere) needs no more
 twins: each would only prove once more that one run is a sample.  Its later seeds run
 without twins, and its distribution is checked instead against a subsample at the twins'

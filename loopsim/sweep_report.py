@@ -222,9 +222,13 @@ def report(sweep_dir, out, seed=0, costliest=COSTLIEST):
 
     Examples
     --------
+    The README's main job's report is ``loopsim.report("runs/phase", "runs/phase.html")``;
+    here a small sweep's:
+
     >>> import loopsim
-    >>> loopsim.report("runs/phase", "runs/phase.html")  # doctest: +SKIP
-    'runs/phase.html'
+    >>> rows = loopsim.sweep([10.0, 40.0], 30.0, "runs/two", n=6, t_end=0.5, twin=False)
+    >>> loopsim.report("runs/two", "runs/two.html")
+    'runs/two.html'
     """
     from . import storage, validation
 

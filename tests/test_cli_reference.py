@@ -4,6 +4,7 @@ consistent; the top-level examples are the README's."""
 import argparse
 import importlib.util
 import os
+import re
 import shlex
 import types
 
@@ -29,8 +30,76 @@ def subcommands(parser):
 
 
 def test_cli_md_is_what_the_parsers_give_now():
+    """The command reference, and the generated lists of docs/cli.md and docs/sweeps.md."""
     assert reference_script().main(["--check"]) == 0, \
-        "docs/cli.md is stale: run python scripts/cli_reference.py"
+        "docs/cli.md or docs/sweeps.md is stale: run python scripts/cli_reference.py"
+
+
+def docs_page(name):
+    with open(os.path.join(ROOT, "docs", name), encoding="utf-8") as handle:
+        return handle.read()
+
+
+def without_generated(text):
+    """A page without its generated parts (the command reference and the lists)."""
+    text = re.sub(r"<!-- BEGIN list .*?<!-- END list [^>]*-->", "", text, flags=re.S)
+    return re.sub(r"<!-- BEGIN generated .*?<!-- END generated [^>]*-->", "", text, flags=re.S)
+
+
+def named(names, text):
+    """The names of ``names`` that ``text`` lists in code spans (`a, b` or `a`, `b`; not
+    names inside code such as `f(a, b=1)`)."""
+    listed = set()
+    for span in re.findall(r"`([^`]*)`", text):
+        items = [item.strip() for item in span.split(",")]
+        if all(re.fullmatch(r"\w+", item) for item in items):
+            listed.update(items)
+    return listed & set(names)
+
+
+def test_the_documented_field_and_column_lists_are_the_codes():
+    """``run --json``'s fields and a cases file's columns are listed once each, generated
+    from ``SUMMARY_FIELDS`` and ``CASE_COLUMNS`` where the docs describe them; no hand-kept
+    list beside them (cli.md's lacked 5 fields, the cases file's columns were in three
+    partial lists)."""
+    from loopsim import SUMMARY_FIELDS
+    from loopsim.columns import CASE_COLUMNS
+
+    script = reference_script()
+    for page, name, generator in script.LISTS:
+        begin, end = script.list_markers(name)
+        block = docs_page(page).split(begin, 1)[1].split(end, 1)[0]
+        listed = re.findall(r"`([^`]+)`", block)
+        assert listed == list({"loopsim.SUMMARY_FIELDS": SUMMARY_FIELDS,
+                               "loopsim.columns.CASE_COLUMNS": CASE_COLUMNS}[name]), name
+    cli_md, sweeps_md = docs_page("cli.md"), docs_page("sweeps.md")
+    json_begin = script.list_markers("loopsim.SUMMARY_FIELDS")[0]
+    assert 0 < cli_md.index(json_begin) - cli_md.index("`loopsim run --json` prints") < 300
+    cases_begin = script.list_markers("loopsim.columns.CASE_COLUMNS")[0]
+    assert 0 < sweeps_md.index(cases_begin) - sweeps_md.index("rows\nof a cases file") < 300
+    cases = next(a for a in subcommands(cli.build_parser())["sweep"]._actions
+                 if "--cases" in a.option_strings)
+    assert all(re.search(rf"\b{name}\b", cases.help) for name in CASE_COLUMNS)
+    for page in os.listdir(os.path.join(ROOT, "docs")):
+        if page.endswith(".md"):
+            for paragraph in without_generated(docs_page(page)).split("\n\n"):
+                if not paragraph.lstrip().startswith("|"):  # column tables: tests/test_outcomes.py
+                    assert len(named(SUMMARY_FIELDS, paragraph)) < 10, (page, paragraph[:80])
+    for paragraph in without_generated(sweeps_md + cli_md).split("\n\n"):
+        if "cases file" in " ".join(paragraph.split()):
+            assert len(named(CASE_COLUMNS, paragraph)) < 5, paragraph[:80]
+
+
+def test_the_list_checks_catch_the_old_lists():
+    from loopsim import SUMMARY_FIELDS
+    from loopsim.columns import CASE_COLUMNS
+
+    old_json = ("`g0, theta0_deg, n, q0, t_end, rtol, atol, w, perturbation, seed, method, "
+                "n_used,\nstatus` and `compile_s`")
+    assert len(named(SUMMARY_FIELDS, old_json)) >= 10
+    old_cases = ("of a cases file (columns `g0, theta0_deg` and optionally `n, seed,\n"
+                 "perturbation`, and per row `method, rtol, t_end`: a given cell")
+    assert len(named(CASE_COLUMNS, old_cases)) == 8
 
 
 def test_the_reference_covers_every_registered_command(monkeypatch):
@@ -94,3 +163,19 @@ def test_the_top_level_examples_include_the_readme_main_job():
     assert " ".join(shlex.quote(w) for w in main_command()) in epilog
     assert "--n 6 --method rkf45" in epilog  # the paper's scheme, one flag away
     assert "--out runs/phase_n6" in epilog and "--n 6 --method rkf45 --out runs/phase " not in epilog
+
+
+def test_summary_figure_help_says_what_the_figure_draws():
+    """The figure's first panel is ``probability_phase_diagram`` in its default style:
+    pies of the regime probabilities (P(3D) alone is its "colour" style)."""
+    import inspect
+
+    from loopsim.figures import distributions
+
+    source = inspect.getsource(distributions.distribution_summary)
+    assert "probability_phase_diagram(cells, ax=axes[0])" in source  # the default style
+    style = inspect.signature(distributions.probability_phase_diagram).parameters["style"]
+    action = next(a for a in subcommands(cli.build_parser())["summary"]._actions
+                  if "--figure" in a.option_strings)
+    assert style.default == "pie" and "pie" in action.help and "P(3D)" not in action.help
+

@@ -25,7 +25,47 @@ def test_docs_build_strict(tmp_path):
     assert (site / "index.html").is_file()
     api = site / "api" / "index.html"
     assert api.is_file()
-    assert "simulate" in api.read_text(encoding="utf-8")
+    html = api.read_text(encoding="utf-8")
+    assert "simulate" in html
+    assert not sphinx_roles(html), sphinx_roles(html)
+    internal = [name for name in api_objects(html) if not api_object_is_public(name)]
+    assert not internal, internal
+
+
+#: A Sphinx role as MkDocs renders it: literally (mkdocstrings reads Markdown, not reST).
+SPHINX_ROLE = re.compile(r":(?:func|class|meth|data|mod|attr|exc|obj|py:\w+):(?:<code>|`)")
+#: What the API page documents besides loopsim.__all__ and SimulationResult's members:
+#: the modules whose docstrings define the results' terms (their functions are internal),
+#: the thresholds a result carries, and the stop table of --seeds auto.
+API_EXTRAS = ("loopsim.seeds_auto_rule", "loopsim.outcomes", "loopsim.outcomes.Thresholds",
+              "loopsim.columns", "loopsim.refinement", "loopsim.storage.read_stop_table")
+
+
+def sphinx_roles(html):
+    return SPHINX_ROLE.findall(html)
+
+
+def api_objects(html):
+    """The objects of a built API page (mkdocstrings' headings), by full name."""
+    return re.findall(r'<h\d id="([^"]+)" class="doc doc-heading"', html)
+
+
+def api_object_is_public(name):
+    import loopsim
+
+    return (name.rsplit(".", 1)[-1] in loopsim.__all__ or name in API_EXTRAS
+            or name.startswith("loopsim.result.SimulationResult."))
+
+
+def test_the_api_page_checks_catch_what_they_are_for():
+    """As the page rendered: a role in a docstring, and a module's internal functions."""
+    assert sphinx_roles("<p>see :func:<code>simulate</code>, :data:`SAME`.</p>") == [
+        ":func:<code>", ":data:`"]
+    html = ('<h2 id="loopsim.api.simulate" class="doc doc-heading">'
+            '<h3 id="loopsim.seeds_auto_rule.widths" class="doc doc-heading">'
+            '<h3 id="loopsim.result.SimulationResult.summary" class="doc doc-heading">')
+    assert [n for n in api_objects(html) if not api_object_is_public(n)] == [
+        "loopsim.seeds_auto_rule.widths"]
 
 
 # ---------------------------------------------------------------------------------
@@ -243,3 +283,54 @@ def test_the_n6_grid_and_the_main_job_have_one_name_each():
         text = page_text(name)
         assert not re.search(r"main job \(n = 6\)|main job's curve|former main job"
                              r"|main-job grid|Main job:", text), name
+
+
+def tension_solve_sentence(text):
+    """The model page's sentence on how T is solved for (from "T minimises" to its end)."""
+    flat = " ".join(text.split())
+    return re.search(r"T minimises.*?\.(?: |$)", flat).group(0).strip()
+
+
+def test_the_model_page_names_the_tension_solve_the_velocity_runs():
+    """docs/model.md names the solve ``loop_velocity`` calls: linalg's Cholesky on the
+    normal equations first, its QR only when that fails (it once said "Householder least
+    squares" for all of it)."""
+    import inspect
+
+    from loopsim import linalg
+    from loopsim.models import loop_maps
+
+    source = inspect.getsource(loop_maps.loop_velocity)
+    calls = [source.index(name) for name in ("least_squares_normal", "least_squares_affine")]
+    assert calls == sorted(calls)  # normal equations first, QR as the fallback
+    assert "Cholesky" in linalg.least_squares_normal.__doc__
+    assert "QR" in linalg.least_squares_affine.__doc__
+    sentence = tension_solve_sentence(page_text("model.md"))
+    assert 0 <= sentence.find("Cholesky") < sentence.find("QR"), sentence
+    assert "normal equations" in sentence
+
+
+def test_the_model_page_gives_each_symbol_one_meaning():
+    """ε is the slenderness a/L there; the length creation has a symbol of its own."""
+    text = page_text("model.md")
+    slenderness = re.search(r"(\S+) = a/L", text).group(1)
+    creation = re.search(r"length creation (\S+)", text).group(1)
+    assert creation != slenderness
+    assert f"∫{slenderness}²" not in text
+
+
+def test_the_model_page_checks_catch_the_old_text():
+    old = ("length creation ε kept to order 2n;\n  T minimises ∫ε² ds (Householder least "
+           "squares on a 4n+1 point grid, which\n  resolves ε exactly).\n")
+    assert "Cholesky" not in tension_solve_sentence(old)
+    assert re.search(r"length creation (\S+)", old).group(1) == "ε"
+
+
+def test_no_page_says_the_summary_figure_draws_p3d_alone():
+    """The summary's figure (``loopsim summary --figure``, ``sweep --seeds auto --figure``)
+    draws a pie of the regime probabilities per cell, not P(3D)."""
+    claim = re.compile(r"--figure`? (?:draws?|also draws?) P\(3D\)|draw P\(3D\) per")
+    assert claim.search("`--figure` draws P(3D) per point and")
+    found = {name: claim.findall(" ".join(page_text(name).split())) for name in pages()}
+    assert not {name: hits for name, hits in found.items() if hits}
+

@@ -37,8 +37,9 @@ EXAMPLES = (
     ("the paper's scheme", "loopsim run --g0 150 --theta0 45 --n 6 --method rkf45"),
     ("the README's main job", "loopsim sweep --g0 10:150:8 --theta0 10:90:9 --n auto "
                               "--out runs/phase --figure runs/phase.png"),
-    ("the paper's n = 6 grid", "loopsim sweep --g0 10:150:8 --theta0 10:90:9 --n 6 --method "
-                               "rkf45 --out runs/phase_n6"),
+    ("the paper's n = 6 grid: its 225 cases, as scripts/make_figures.py runs them",
+     "loopsim sweep --g0 10:350:15 --theta0 6:90:15 --n 6 --method rkf45 --no-twin "
+     "--out runs/phase_n6"),
     ("the circle's stability", "loopsim stability --n 16"),
 )
 

@@ -23,8 +23,9 @@ def add_parser(commands):
     summary.add_argument("--seed", type=int, default=0, metavar="SEED",
                          help="seed of the bootstrap (>= 0)")
     summary.add_argument("--figure", metavar="PNG",
-                         help="also draw P(3D) per cell, the terminal tilt over seeds and the "
-                         "aspect ratio over the steady branch")
+                         help="also draw the regime probabilities of each cell (a pie "
+                         "each), the terminal tilt over seeds and the aspect ratio over the "
+                         "steady branch")
     return summary
 
 

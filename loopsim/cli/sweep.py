@@ -3,6 +3,7 @@ when re-run; also reruns of a sweep's failed cases (``--rerun-failed``)."""
 import math
 import sys
 
+from ..columns import CASE_COLUMNS, CASE_OVERRIDES
 from ..defaults import (
     DEFAULT_AUTO_CHUNK_SIZE, DEFAULT_CHUNK_SIZE, DEFAULT_N, PERTURBATION_ENSEMBLE, SEED_TARGETS,
 )
@@ -81,10 +82,11 @@ def _add_case_options(sweep):
                       "until its answer is sharp (see --p-halfwidth; docs/distributions.md). "
                       "Probabilities over seeds are over this ensemble: "
                       + PERTURBATION_ENSEMBLE)
-    grid.add_argument("--cases", metavar="FILE", help="CSV/Parquet with columns g0, theta0_deg "
-                      "[, n, seed, perturbation, initial, initial_case_id] instead of a grid "
-                      "(initial: a point file or results per row, paths relative to FILE; "
-                      "theta0_deg then left empty)")
+    grid.add_argument("--cases", metavar="FILE", help="CSV/Parquet with columns "
+                      f"{', '.join(CASE_COLUMNS[:2])} [, {', '.join(CASE_COLUMNS[2:])}] "
+                      "instead of a grid, one row per case (initial: a point file or results "
+                      "per row, paths relative to FILE, theta0_deg then left empty; "
+                      f"{', '.join(CASE_OVERRIDES)}: that row's own option)")
 
 
 def _add_output_options(output):

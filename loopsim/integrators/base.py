@@ -16,12 +16,23 @@ def start(method, problem, y, f, options):
     raise NotImplementedError("only callable from jitted code")
 
 
+#: The step size that asks ``attempt`` for no step: only the work ``start`` or ``advance``
+#: left to be done at their (y, f).  The driver calls ``attempt(..., CATCH_UP, ...)``
+#: right after each of them, so the work is done where it was asked for; radau5 leaves
+#: its Jacobian evaluations to it, so that besides the driver one compiled function (the
+#: attempt) holds the Jacobian's code, not three (docs/performance.md, "Compilation").
+#: A real step has h > 0 (``control.stop_check`` ends the run first).
+CATCH_UP = -1.0
+
+
 @generic
 def attempt(method, work, problem, y, f, h, y_new, options):
     """Attempt one step of size h from y (f = F(y)): y_new and the verdict.
 
     Returns (accepted, h_next, RHS evaluations): h_next is the step to retry
-    with after a rejection, or the proposal after an acceptance.
+    with after a rejection, or the proposal after an acceptance.  With h =
+    :data:`CATCH_UP` there is no step: the work start or advance left at (y, f) is done
+    (nothing for most methods), and it returns (True, 0.0, RHS evaluations).
     """
     raise NotImplementedError("only callable from jitted code")
 

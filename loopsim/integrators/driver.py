@@ -15,7 +15,7 @@ import numpy as np
 from ..jit import entry, kernel
 from ..linalg import copy_into
 from ..models import rhs
-from .base import advance, attempt, dense_output, start, statistics
+from .base import CATCH_UP, advance, attempt, dense_output, start, statistics
 from .control import (
     NON_FINITE, OK, all_finite, initial_step, initial_step_probe, initial_worst, landing, monitor,
     monitor_start, outputs_at_start, stop_check,
@@ -83,7 +83,7 @@ def integrate(method, problem, y0, t0, t_end, t_out, options, y_out):
         i_out = outputs_at_start(y, t0, t_out, y_out)
     next_check, previous, quiet = monitor_start(problem, y, t0, options)
     work, evals = start(method, problem, y, f, options)
-    n_rhs += evals
+    n_rhs += evals + attempt(method, work, problem, y, f, CATCH_UP, y_new, options)[2]
     if options.first_step > 0.0:
         h = min(options.first_step, options.max_step)
     else:
@@ -128,6 +128,6 @@ def integrate(method, problem, y0, t0, t_end, t_out, options, y_out):
         if stop >= 0:
             return stop, t, y, _counts(method, work, counts, n_acc, n_rej, n_rhs), worst
         h_next, evals = advance(method, work, problem, y, f, h_try, h_next)
-        n_rhs += evals
+        n_rhs += evals + attempt(method, work, problem, y, f, CATCH_UP, y_new, options)[2]
         h = min(options.max_step, h_next)
     return OK, t, y, _counts(method, work, counts, n_acc, n_rej, n_rhs), worst

@@ -55,7 +55,10 @@ def _explicit_attempt(method, work, problem, y, f, h, y_new, options):
     RMS norm of err in the scale atol + rtol max(|y|, |y_new|) is at most 1.
 
     Overwrites work.k, work.stage, work.err and work.scale; costs s − 1 RHS evaluations.
+    With h = ``base.CATCH_UP``: nothing (start and advance leave no work).
     """
+    if h < 0.0:
+        return True, 0.0, 0
     k = work.k
     stage = work.stage
     copy_into(k[0], f)

@@ -167,7 +167,7 @@ def newton_matrices(jac, h, lu_real, piv_real, lu_complex, piv_complex):
     lu_factor(lu_complex, piv_complex)
 
 
-@kernel
+@kernel(inline=True)  # in the step attempt: a library of its own would hold the rhs again
 def solve_collocation(problem, y, h, z, scale, tol, noise, maxiter, lu_real, piv_real,
                       lu_complex, piv_complex, w, fz, stage, real_rhs, complex_rhs):
     """Simplified Newton for Z = h A F(y + Z), from the guess in z (3, n), updated in place.
@@ -299,7 +299,7 @@ RadauWork = collections.namedtuple(
     "RadauWork", "scale work_y work_f err real_rhs complex_rhs z poly w fz jac lu_real "
     "lu_complex piv_real piv_complex scalars")
 (H_LU, H_OLD, ERR_OLD, REJECTED, JAC_CURRENT, NEWTON_TOL, ERR_NORM, RECOMPUTE_JAC, JACOBIANS,
- FACTORISATIONS) = range(10)
+ FACTORISATIONS, JAC_PENDING) = range(11)
 
 
 @implements(start, RadauIIA)
@@ -310,10 +310,9 @@ def _radau_start(method, problem, y, f, options):
         np.empty(n, dtype=np.complex128), np.zeros((3, n)), np.zeros((3, n)),
         np.empty((3, n)), np.empty((3, n)), np.empty((n, n)), np.empty((n, n)),
         np.empty((n, n), dtype=np.complex128), np.empty(n, dtype=PIVOT_DTYPE),
-        np.empty(n, dtype=PIVOT_DTYPE), np.zeros(10))
-    evals = jacobian(problem, y, f, work.jac, work.work_y, work.work_f)
+        np.empty(n, dtype=PIVOT_DTYPE), np.zeros(11))
     s = work.scalars
-    s[JACOBIANS] = 1.0
+    s[JAC_PENDING] = 1.0  # the Jacobian at y: the driver's catch-up call evaluates it next
     s[H_LU] = -1.0
     s[H_OLD] = -1.0  # last accepted step (-1: none yet)
     s[ERR_OLD] = -1.0
@@ -321,13 +320,20 @@ def _radau_start(method, problem, y, f, options):
     s[JAC_CURRENT] = 1.0
     s[NEWTON_TOL] = max(NEWTON_TOL_FLOOR * EPS / options.rtol,
                         min(NEWTON_TOL_MAX, options.rtol ** 0.5))
-    return work, evals
+    return work, 0
 
 
 @implements(attempt, RadauIIA)
 def _radau_attempt(method, work, problem, y, f, h, y_new, options):
     n = y.shape[0]
     s = work.scalars
+    if h < 0.0:  # base.CATCH_UP: the Jacobian start or advance asked for at (y, f)
+        evals = 0
+        if s[JAC_PENDING] != 0.0:
+            evals = jacobian(problem, y, f, work.jac, work.work_y, work.work_f)
+            s[JACOBIANS] += 1.0
+            s[JAC_PENDING] = 0.0
+        return True, 0.0, evals
     f_max = 0.0
     for i in range(n):
         f_max = max(f_max, abs(f[i]))
@@ -391,17 +397,15 @@ def _radau_attempt(method, work, problem, y, f, h, y_new, options):
 @implements(advance, RadauIIA)
 def _radau_advance(method, work, problem, y, f, h, h_proposal):
     s = work.scalars
-    evals = 0
     if s[RECOMPUTE_JAC] != 0.0:
-        evals += jacobian(problem, y, f, work.jac, work.work_y, work.work_f)
-        s[JACOBIANS] += 1.0
+        s[JAC_PENDING] = 1.0  # evaluated at y by the driver's catch-up call, next
         s[JAC_CURRENT] = 1.0
         s[H_LU] = -1.0
     else:
         s[JAC_CURRENT] = 0.0
     s[H_OLD] = h
     s[ERR_OLD] = s[ERR_NORM]
-    return h_proposal, evals
+    return h_proposal, 0
 
 
 @implements(dense_output, RadauIIA)

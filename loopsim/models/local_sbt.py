@@ -8,11 +8,13 @@ tail and steady-state invariants).  Their names are re-exported here.
 """
 import collections
 
+import numpy as np
+
 from ..linalg import copy_into
 from .base import (
     auxiliary, for_case, implements, jacobian, monitored_errors, rhs, steady_invariants,
 )
-from .loop_jacobian import loop_jacobian
+from .loop_jacobian import loop_jacobian, mobility_jacobian  # noqa: F401 - re-exported
 from .loop_maps import (  # noqa: F401 - re-exported
     LoopOperators, Workspace, compose_maps, force_map, grid_size, length_creation,
     length_creation_map, length_rate_operator, loop_velocity, loop_velocity_blocks,
@@ -46,8 +48,14 @@ implements(rhs, LoopProblem)(loop_velocity)
 
 @implements(jacobian, LoopProblem)
 def _loop_jacobian(problem, y, f, jac, work_y, work_f):
+    # loop_jacobian's two calls, not a call of that kernel: every library holding the
+    # Jacobian holds all its callees' code, so a layer fewer compiles it once less
+    # (docs/performance.md, "Compilation").
     k = y.shape[0] // 3
-    loop_jacobian(y.reshape((3, k)), problem.g0, problem.w, problem.ops, problem.ws, jac)
+    x = y.reshape((3, k))
+    u = np.empty_like(x)
+    loop_velocity_blocks(x, problem.g0, problem.w, problem.ops, problem.ws, u)
+    mobility_jacobian(problem.w, 1.0, 1.0, 0.0, None, None, None, problem.ops, problem.ws, jac)
     return 1  # one velocity evaluation inside
 
 

@@ -4,6 +4,7 @@ the shape, the nonlocal one's (``nonlocal_maps.nonlocal_jacobian``)."""
 import numpy as np
 
 from ..jit import kernel
+from ..linalg import solve
 from .loop_maps import loop_velocity_blocks
 
 
@@ -16,7 +17,7 @@ def loop_jacobian(x, g0, w, ops, ws, jac):
     mobility_jacobian(w, 1.0, 1.0, 0.0, None, None, None, ops, ws, jac)
 
 
-@kernel
+@kernel(inline=True)  # in its callers: a library of its own would compile it once more
 def mobility_jacobian(w, isotropic, along, nonlocal_share, weight, direction, position, ops,
                       ws, jac):
     """J = ∂u/∂x (3K × 3K, component-major) of the loop velocity with mobility
@@ -146,7 +147,7 @@ def mobility_jacobian(w, isotropic, along, nonlocal_share, weight, direction, po
     if weight is not None:
         add_kernel_shape_adjoint(nonlocal_share, weight, direction, inverse, t, rho, ws.force,
                                  S0, S1, rhs_t)
-    dtau = -np.linalg.solve(np.dot(a.T, a), rhs_t)  # (K, D)
+    dtau = -solve(np.dot(a.T, a), rhs_t)  # (K, D): np.linalg.solve's gesv, bit for bit
     # δu = F (δm + m_T δT), then arrange as J[(c', k'), (c, k)]
     m_t = np.empty((m * 3, k))
     for i in range(m):

@@ -170,7 +170,7 @@ def length_creation_map(w, ops, ws):
         ws.length_rate[k, i] -= w * (1.0 - stretch)
 
 
-@kernel
+@kernel(inline=True)
 def compose_maps(x, g0, w, ops, ws):
     """Maps (1)-(3) for shape x: the affine map T -> ε as the block ws.length_rate."""
     shape_on_grid(x, ops, ws)
@@ -205,7 +205,7 @@ def tension_operator(ops, ws):
             row[i] = p1[i] * (t[0, i] * t0 + t[1, i] * t1 + t[2, i] * t2)
 
 
-@kernel
+@kernel(inline=True)
 def tension_columns(ops, ws):
     """(B S0)ᵀ into ws.partial and (B₂ S0)ᵀ into ws.length_rate[:K] (B, B₂:
     :func:`tension_operator`), in O(n M) operations instead of two (K, M) @ (M, M) products.
@@ -284,7 +284,7 @@ def tension_columns(ops, ws):
             e_sin[i] = sin_j[i] * zr + cos_j[i] * zi
 
 
-@kernel
+@kernel(inline=True)
 def length_rate_operator(g0, w, ops, ws):
     """The affine map T -> ε into ws.length_rate: rows 0..K-1 the columns of
     A = (B₂ + B B) S0 (stored Aᵀ = S0ᵀ B₂ᵀ + (S0ᵀ Bᵀ) Bᵀ), row K the T = 0 part b.
@@ -359,7 +359,7 @@ def loop_velocity(problem, y, dydt):
     np.dot(ws.velocity, ops.FT, u_out)
 
 
-@kernel
+@kernel(inline=True)
 def loop_velocity_blocks(x, g0, w, ops, ws, u_out):
     """:func:`loop_velocity` through the column blocks of :func:`compose_maps`: the
     previous dense path, kept as the Jacobian's first step and as the fast path's reference.
@@ -370,7 +370,7 @@ def loop_velocity_blocks(x, g0, w, ops, ws, u_out):
     velocity_from_blocks(ops, ws, u_out)
 
 
-@kernel
+@kernel(inline=True)
 def velocity_from_blocks(ops, ws, u_out):
     """From the column blocks (ws.length_rate: T -> ε; ws.mobile: T -> u on the grid): the
     least-squares tension T into ws.tension (ws.length_rate destroyed) and the velocity

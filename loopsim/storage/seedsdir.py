@@ -124,13 +124,13 @@ def read_results(out):
     ValueError naming it: re-running the sweep's command moves it aside and recomputes
     its cases), carry the fingerprint of the configuration in ``_sweep.json`` and hold
     exactly the cases its name says; no case may appear twice.  A ``--seeds auto``
-    directory is read round by round (:func:`read_seeds_auto`): its rows get a ``round``
+    directory is read round by round (``read_seeds_auto``): its rows get a ``round``
     column and ``case_id`` is renumbered in (round, case_id) order.
 
     Parameters
     ----------
     out : str
-        A sweep directory (``loopsim sweep --out``, :func:`loopsim.sweep`) or a
+        A sweep directory (``loopsim sweep --out``, ``loopsim.sweep``) or a
         ``--seeds auto`` directory.
 
     Returns
@@ -152,9 +152,15 @@ def read_results(out):
 
     Examples
     --------
+    A sweep directory (the README's main job writes ``runs/phase``), here a small one:
+
     >>> import loopsim
-    >>> frame = loopsim.read_results("runs/phase")  # doctest: +SKIP
-    >>> frame.groupby("regime").size()  # doctest: +SKIP
+    >>> rows = loopsim.sweep([10.0, 40.0], 30.0, "runs/two", n=6, t_end=0.5, twin=False)
+    >>> frame = loopsim.read_results("runs/two")
+    >>> frame.groupby("regime").size()
+    regime
+    stable    2
+    dtype: int64
     """
     if os.path.isdir(out) and is_seeds_auto(out):
         return read_seeds_auto(out)
@@ -187,9 +193,13 @@ def read_stop_table(out):
 
     Examples
     --------
-    >>> from loopsim import io
-    >>> stops = io.read_stop_table("runs/seeds")  # doctest: +SKIP
-    >>> stops[["g0", "theta0_deg", "seeds", "stop_reason"]]  # doctest: +SKIP
+    >>> import loopsim
+    >>> from loopsim import storage
+    >>> rows = loopsim.sweep(10.0, 30.0, "runs/seeds", n=6, t_end=0.5, seeds="auto",
+    ...                      max_seeds=4)
+    >>> storage.read_stop_table("runs/seeds")[["g0", "theta0_deg", "seeds", "stop_reason"]]
+         g0  theta0_deg  seeds    stop_reason
+    0  10.0        30.0      4  deterministic
     """
     path = os.path.join(out, STOPS_FILE)
     if not os.path.isfile(path):

@@ -177,8 +177,11 @@ def read_snapshots(out):
     Examples
     --------
     >>> import loopsim
-    >>> loopsim.sweep(150, 60, "runs/one", n=6, snapshots_for=[0])  # doctest: +SKIP
-    >>> loopsim.read_snapshots("runs/one").groupby("case_id")["t"].max()  # doctest: +SKIP
+    >>> rows = loopsim.sweep(150, 60, "runs/one", n=6, t_end=1.0, snapshots_for=[0])
+    >>> loopsim.read_snapshots("runs/one").groupby("case_id")["t"].max()
+    case_id
+    0    1.0
+    Name: t, dtype: float64
     """
     if not os.path.isdir(out):
         return pd.DataFrame()

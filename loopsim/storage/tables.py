@@ -63,7 +63,7 @@ def coefficients(row):
     Parameters
     ----------
     row : pandas.Series, dict or array_like
-        A row of :func:`loopsim.read_results` (or a dict) with the column ``x_final``, or
+        A row of ``loopsim.read_results`` (or a dict) with the column ``x_final``, or
         that column's value itself (3 (2n + 1) numbers, row-major).
 
     Returns

@@ -11,6 +11,7 @@ import numpy as np
 import pandas as pd
 
 from .. import integrators, models, refinement, shapes, storage, validation
+from ..columns import CASE_COLUMNS, CASE_OVERRIDES  # declared with the other columns
 from ..defaults import (
     DEFAULT_ATOL, DEFAULT_CHUNK_SIZE, DEFAULT_LENGTH_TOL, DEFAULT_MAX_STEPS, DEFAULT_N_MAX,
     MODEL_CHOICES,
@@ -74,7 +75,7 @@ class SweepConfig:
     n_max: int = DEFAULT_N_MAX
     tail_tol: float = DEFAULT_TAIL_TOL
     twin: bool = True  # run each case's stricter twin (loopsim.outcomes: determined or not)
-    model: str = "local"  # the hydrodynamic model (config.MODEL_CHOICES; models.Model)
+    model: str = "local"  # the hydrodynamic model (defaults.MODEL_CHOICES; models.Model)
     slenderness: float = None  # a/L of the nonlocal model
 
     def step_options(self):
@@ -120,13 +121,6 @@ def _cell(path, row, column, value, integer):
                              f"integer, got {value!r}")
         return int(number)
     return number
-
-
-#: Optional per-case columns of a cases file that override the sweep's option.
-CASE_OVERRIDES = ("method", "rtol", "t_end", "model", "slenderness")
-#: Every column a cases file may have.
-CASE_COLUMNS = ("g0", "theta0_deg", "n", "seed", "perturbation", "initial",
-                "initial_case_id") + CASE_OVERRIDES
 
 
 def _check_case_columns(path, names):
