@@ -185,7 +185,7 @@ def simulate(
         With ``n="auto"``: the first order; None: 6, or a given shape's (see ``initial``).
     twin : bool, default True
         Also run the twin at 10x stricter tolerances that says whether the outcome is
-        ``determined`` (``loopsim.outcomes``); run and twin together cost about 2.7x the
+        ``determined`` (``loopsim.outcomes``); run and twin together cost about 2.7 times the
         run alone (docs/auto-and-determinacy.md).
     model : {"local", "nonlocal"}, default "local"
         The hydrodynamics: the paper's local slender-body theory, or full slender-body

@@ -10,7 +10,7 @@ two rows with one seed in one cell differ in an input the table does not record 
 * ``seeds``, ``resolved``, ``determined``, ``steady``: how many rows, and how many of
   them are resolved and determined (``loopsim.outcomes``) and reached a steady state
   before ``t_end`` (unknown, ``<NA>``, where the sweep ran without the early stop:
-  :func:`steady_tested`);
+  ``steady_tested``);
 * ``p_<regime>`` for each regime, with its 95 % Wilson score interval
   ``p_<regime>_low``, ``p_<regime>_high``:
 
@@ -164,7 +164,7 @@ def summarize(frame, by=None, seed=0):
           ``t_end`` (the others ran to ``t_end``, their "terminal" values the state
           there, or failed; ``steady`` only where ``frame`` has ``stop_reason``, and
           unknown, ``<NA>``, where its sweep ran with ``--no-early-stop``:
-          :func:`steady_tested`);
+          ``steady_tested``);
         * ``p_<regime>`` for each regime (stable, in_plane, 3d, failed), with its 95 %
           Wilson score interval ``p_<regime>_low``, ``p_<regime>_high``:
           (p̂ + z²/2N ± z sqrt(p̂(1 − p̂)/N + z²/4N²)) / (1 + z²/N), z = Φ⁻¹(0.975);

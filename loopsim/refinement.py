@@ -32,7 +32,7 @@ from .integrators.control import REFINE
 
 #: Where ``n="auto"`` starts for the tilted circle (the paper's resolution).
 AUTO_START = DEFAULT_N
-#: The ``method`` values a user may give: the integrators, or "auto" (:func:`auto_method`).
+#: The ``method`` values a user may give: the integrators, or "auto" (``auto_method``).
 METHOD_CHOICES = tuple(integrators.METHODS) + ("auto",)
 #: Above this q0 the circle is linearly unstable out of its plane (full linearisation,
 #: docs/stability.md): the case is expected to turn 3D.
@@ -63,7 +63,7 @@ def level_options(options, tail_tol, top):
 
 
 class CaseRun(typing.NamedTuple):
-    """What :func:`integrate_case` returns (a tuple: it unpacks in this order)."""
+    """What ``integrate_case`` returns (a tuple: it unpacks in this order)."""
 
     status: int  #: ``integrators.STATUS_NAMES`` code of the last level
     t_final: float  #: time reached, in t_u
@@ -75,7 +75,7 @@ class CaseRun(typing.NamedTuple):
 
 
 class CasesRun(typing.NamedTuple):
-    """What :func:`integrate_cases` returns, per case b (a tuple: it unpacks in this order)."""
+    """What ``integrate_cases`` returns, per case b (a tuple: it unpacks in this order)."""
 
     x_final: list  #: B arrays (3, 2 n_used[b] + 1), in L/2π
     n_used: np.ndarray  #: (B,) the last order each case reached
@@ -90,7 +90,7 @@ def integrate_case(method, g0, w, x0, t0, t_end, t_eval, options, ladder, tail_t
     """One case of ``model`` (``models.Model``) up the ladder (from x0 (3, 2 ladder[0] + 1)
     at t0), each order from t0.
 
-    Returns a :class:`CaseRun` (status, t_final, x_final, n_used, counts, worst, x_out): counts as
+    Returns a ``CaseRun`` (status, t_final, x_final, n_used, counts, worst, x_out): counts as
     ``integrators.integrate``, summed over the levels (the work of every level);
     worst = [largest length error, largest spectral tail] of the last level's run;
     n_used the last order reached; x_out (len(t_eval), 3, 2 n_used + 1) the states at
@@ -125,7 +125,7 @@ def integrate_cases(method, parameters, x0, t_end, options, ladder, tail_tol, co
     order from t0.
 
     x0 (B, 3, 2 ladder[0] + 1); parameters (B, P) each case's
-    ``models.case_parameters``.  Returns a :class:`CasesRun` (x_final,
+    ``models.case_parameters``.  Returns a ``CasesRun`` (x_final,
     n_used, t_final, status, counts, worst): x_final a list of B arrays (3, 2 n_used
     + 1); counts summed over the levels; the others those of each case's last level.
     """

@@ -101,7 +101,7 @@ def any_succeeded(rows):
 
 def runs_are_samples(rows):
     """Whether a cell's runs are samples of a distribution rather than determined
-    trajectories: some run succeeded (:func:`any_succeeded`; a cell with none has no
+    trajectories: some run succeeded (``any_succeeded``; a cell with none has no
     distribution), and its seeds end in more than one regime, or a run's twin (at
     stricter tolerances) ends elsewhere (``determined`` False)."""
     return any_succeeded(rows) and bool(rows["regime"].nunique() > 1

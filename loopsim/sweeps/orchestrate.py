@@ -150,7 +150,7 @@ def sweep(g0, theta0_deg, out, *, n="auto", seeds=1, method=None, t_end=DEFAULT_
         RMS size of the seeded initial perturbation, in L/2π (0: the exact circle).
     twin : bool, default True
         Also run the twin at 10x stricter tolerances that says whether the outcome is
-        ``determined`` (``loopsim.outcomes``); run and twin together cost about 2.7x the
+        ``determined`` (``loopsim.outcomes``); run and twin together cost about 2.7 times the
         run alone (docs/auto-and-determinacy.md).
     early_stop : bool, default True
         Stop a case once its shape and tilt are steady (docs/sweeps.md).
