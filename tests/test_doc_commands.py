@@ -152,12 +152,12 @@ def make_figures_steps():
 
 def sweep_fingerprint(words):
     """The configuration fingerprint a sweep command's directory would get (no case run)."""
-    from loopsim import storage, sweeps
+    from loopsim import storage
     from loopsim.cli import sweep as sweep_command
 
     args = cli.build_parser().parse_args(words)
-    assert sweep_command._parse_seeds(args) is None  # as the command: --seeds K into an int
-    config = sweep_command._sweep_config(args, sweeps)
+    config, targets = sweep_command.configuration(args)
+    assert targets is None  # a fixed number of seeds
     return storage.config_fingerprint(json.loads(json.dumps(config.as_dict())))
 
 

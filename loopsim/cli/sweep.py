@@ -206,6 +206,15 @@ def _sweep_config(args, sweeps):
                               n_max=args.n_max, tail_tol=args.tail_tol)
 
 
+def configuration(args):
+    """What a sweep command's parsed arguments ask for, checked, with nothing run: (the
+    ``sweeps.SweepConfig``, the ``--seeds auto`` targets or None)."""
+    from .. import sweeps
+
+    targets = _parse_seeds(args)
+    return _sweep_config(args, sweeps), targets
+
+
 def _parse_seeds(args):
     """``--seeds K|auto`` into an int or "auto", and the --seeds auto targets
     (``seeds_auto_rule.SeedTargets``, or None), each refused where it does not apply."""

@@ -27,13 +27,16 @@ def read_run(path):
 
     try:
         meta = storage.read_metadata(path)
-        if "summary" not in meta:
-            raise ValueError(f"{path!r} is not a run file (written by 'loopsim run --out'): "
-                             "no run summary in its metadata")
+    except (OSError, ValueError) as exc:  # not Parquet, or a footer that does not decode
+        raise ValueError(f"cannot read {path!r}: {str(exc).splitlines()[0]}") from None
+    if "summary" not in meta:
+        raise ValueError(f"cannot read {path!r}: not a run file (written by 'loopsim run "
+                         "--out'): no run summary in its metadata")
+    try:
         frame = storage.read_table_checked(path).to_pandas()
-    except storage.DamagedFile as exc:
+    except storage.DamagedFile as exc:  # a run file whose pages or content fail their checks
         raise ValueError(f"{exc}; run it again (loopsim run --out)") from None
-    except (OSError, ValueError) as exc:
+    except OSError as exc:
         raise ValueError(f"cannot read {path!r}: {str(exc).splitlines()[0]}") from None
     missing = {"t", "x", "multiplier"} - set(frame.columns)
     if missing:
