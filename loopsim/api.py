@@ -11,8 +11,10 @@ import warnings
 
 import numpy as np
 
-from . import _jitcache, diagnostics, integrators, storage, models, outcomes, refinement, shapes, \
-    validation
+from . import (
+    _jitcache, diagnostics, integrators, late_motion, models, outcomes, refinement, shapes,
+    storage, validation,
+)
 from .defaults import (
     DEFAULT_ATOL, DEFAULT_LENGTH_TOL, DEFAULT_MAX_STEPS, DEFAULT_N_MAX, DEFAULT_RTOL,
     DEFAULT_SEED, DEFAULT_STEADY_INTERVAL, DEFAULT_T_END, DEFAULT_TAIL_TOL, DEFAULT_W,
@@ -244,11 +246,11 @@ def simulate(
     inputs = dict(g0=g0, theta0_deg=theta0_deg, n=n, t_end=t_end, rtol=rtol, atol=atol,
                   w=w, perturbation=perturbation, seed=int(seed), model=model.name,
                   slenderness=model.slenderness)
-    run, twin_state, wall, compile_s = _run_and_twin(
+    run, twin_state, motion, wall, compile_s = _run_and_twin(
         integrators.METHODS[method], g0, w, x0, t0, t_end, t_eval, options, ladder,
         tail_tol, theta0_deg, model, twin)
     result = _result(run, inputs, method, t_eval, g0, w, model, x0, initial_info, twin_state,
-                     wall, compile_s)
+                     motion, wall, compile_s)
     for line in result.warnings():
         warnings.warn(line, LoopsimWarning, stacklevel=2)
     return result
@@ -317,12 +319,16 @@ def _output_times(t_eval, snapshots, t0, t_end):
 
 def _run_and_twin(method_object, g0, w, x0, t0, t_end, t_eval, options, ladder, tail_tol,
                   theta0_deg, model, twin):
-    """The run (``refinement.CaseRun``) and, with ``twin``, its twin's end state; the
-    run's own wall time (compilation out, the twin's share out) and the compile time."""
+    """The run (``refinement.CaseRun``, its x_out at ``t_eval``) and, with ``twin``, its
+    twin's end state; its late-motion fields (``late_motion``, from samples of the same
+    run); the run's own wall time (compilation out, the twin's share out) and the compile
+    time."""
     compiled = _jitcache.compile_seconds()
     start = time.perf_counter()
+    samples = late_motion.sample_times(t0, t_end)
+    times = np.union1d(t_eval, samples)  # one run: dense output leaves the steps alone
     run = refinement.integrate_case(
-        method_object, g0, w, x0, t0, t_end, t_eval, options, ladder, tail_tol, model)
+        method_object, g0, w, x0, t0, t_end, times, options, ladder, tail_tol, model)
     twin_state = None
     if twin and run.status in integrators.SUCCESS:
         twin_state = twin_end_state(method_object, g0, w, x0, t0, t_end, options, ladder,
@@ -335,11 +341,17 @@ def _run_and_twin(method_object, g0, w, x0, t0, t_end, t_eval, options, ladder, 
     if twin_state is not None:  # the twin's time is not the run's: split by RHS evaluations
         nfev = int(run.counts[integrators.COUNTS.index("nfev")])
         wall *= float(nfev) / (nfev + twin_state["nfev"])
-    return run, twin_state, wall, compile_s
+    motion = late_motion.late_motion(
+        samples, run.x_out[np.searchsorted(times, samples)], t0, t_end, run.t_final,
+        run.x_final,
+        run.status in integrators.SUCCESS, run.status == integrators.STEADY,
+        outcomes.Thresholds())
+    run = run._replace(x_out=run.x_out[np.searchsorted(times, t_eval)])
+    return run, twin_state, motion, wall, compile_s
 
 
-def _result(run, inputs, method, t_eval, g0, w, model, x0, initial_info, twin_state, wall,
-            compile_s):
+def _result(run, inputs, method, t_eval, g0, w, model, x0, initial_info, twin_state, motion,
+            wall, compile_s):
     """The :class:`SimulationResult` of a run: its states at the output times reached,
     with their velocities and multipliers."""
     problem = models.make_problem(model, run.n_used, g0, w)
@@ -357,5 +369,5 @@ def _result(run, inputs, method, t_eval, g0, w, model, x0, initial_info, twin_st
         u_final=u_final, multiplier_final=multiplier_final, status_code=int(run.status),
         wall_s=wall, length_error_max=float(run.worst[0]), n_used=int(run.n_used),
         tail_max=float(run.worst[1]), initial_info=initial_info,
-        aspect_ratio_initial=diagnostics.aspect_ratio(x0), twin=twin_state,
+        aspect_ratio_initial=diagnostics.aspect_ratio(x0), twin=twin_state, motion=motion,
         compile_s=compile_s, **stats)

@@ -83,6 +83,22 @@ RESULT_COLUMNS = {
     "twin_regime": (TEXT, "the twin's regime (null: no twin ran)"),
     "twin_theta_final_deg": (DEG, "the twin's terminal tilt (NaN: no twin ran)"),
     "twin_aspect_ratio": (ONE, "the twin's terminal aspect ratio (NaN: no twin ran)"),
+    "terminal_state": (TEXT, "steady (the steady test passed: stopped early) | quiet (ran to "
+                             "t_end; the late window's tilt and aspect ranges within the "
+                             "regime thresholds) | unsteady (they moved more: the terminal "
+                             "values are a snapshot of motion) | failed (loopsim.late_motion; "
+                             "null: written before it existed)"),
+    "late_tilt_mean_deg": (DEG, "mean tilt over the late window [t_final - (t_end - t0) / 5, "
+                                "t_final] (samples every (t_end - t0) / 400, and the "
+                                "terminal state)"),
+    "late_tilt_min_deg": (DEG, "smallest tilt in the late window"),
+    "late_tilt_max_deg": (DEG, "largest tilt in the late window"),
+    "late_aspect_mean": (ONE, "mean aspect ratio over the late window"),
+    "late_aspect_min": (ONE, "smallest aspect ratio in the late window"),
+    "late_aspect_max": (ONE, "largest aspect ratio in the late window"),
+    "time_since_swing": (TIME, "t_final minus the last sampled time at which the tilt stood "
+                               "more than tilt_change_deg (1 deg) from its terminal value "
+                               "(t_final - t0 if never): how long the final tilt has held"),
     "stop_reason": (TEXT, "t_end | steady (terminal state reached early) | the failure"),
     "aspect_ratio_initial": (ONE, "aspect ratio of the start"),
     "length_error_max": (ONE, "largest |relative length error| along the trajectory"),
@@ -120,6 +136,12 @@ SUMMARY_COLUMNS = {
                       "steady); the others ran to t_end, their terminal values the state there, or "
                       "failed (empty, unknown, for a sweep run with --no-early-stop: no run was "
                       "tested)"),
+    "unsteady": (COUNT, "rows of the cell still moving at their end (terminal_state "
+                        "unsteady; empty where a row does not record it)"),
+    **{f"p_unsteady{end}": (PROBABILITY, what) for end, what in (
+        ("", "share of the cell's rows still moving at their end (terminal_state unsteady)"),
+        ("_low", "lower end of the 95% Wilson score interval of the share"),
+        ("_high", "upper end of the 95% Wilson score interval of the share"))},
     **{f"p_{regime}{end}": (PROBABILITY, f"{what} of the regime {label}")
        for regime, label in (("stable", "stable"), ("in_plane", "in-plane"), ("3d", "3d"),
                              ("failed", "failed"))

@@ -84,6 +84,19 @@ def tilt_deg(x):
     return float(np.degrees(np.arccos(min(1.0, abs(vectors[2, 0])))))
 
 
+def tilts_and_aspect_ratios(xs):
+    """:func:`tilt_deg` and :func:`aspect_ratio` of many shapes xs (K, 3, 2n+1) at once:
+    two arrays (K,), NaN for a shape that is not finite (a time not reached)."""
+    xs = np.asarray(xs, dtype=float)
+    finite = np.all(np.isfinite(xs), axis=(1, 2))
+    modes = np.where(finite[:, None, None], xs, 0.0)[:, :, 1:]
+    values, vectors = np.linalg.eigh(0.5 * modes @ np.swapaxes(modes, 1, 2))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        tilt = np.degrees(np.arccos(np.minimum(1.0, np.abs(vectors[:, 2, 0]))))
+        aspect = values[:, 2] / values[:, 1]
+    return np.where(finite, tilt, np.nan), np.where(finite, aspect, np.nan)
+
+
 def aspect_ratio(x):
     """Paper's aspect ratio: largest / middle covariance eigenvalue (variances)."""
     values, _ = principal_axes(x)

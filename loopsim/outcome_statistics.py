@@ -114,6 +114,11 @@ def _cell_row(rows, seed, tested=True):
                determined=int(rows["determined"].eq(True).sum()))
     if "stop_reason" in rows:
         out["steady"] = int(rows["stop_reason"].eq("steady").sum()) if tested else pd.NA
+    if "terminal_state" in rows and rows["terminal_state"].notna().all():
+        unsteady = int(rows["terminal_state"].eq("unsteady").sum())
+        out["unsteady"] = unsteady
+        out["p_unsteady"] = unsteady / trials
+        out["p_unsteady_low"], out["p_unsteady_high"] = wilson_interval(unsteady, trials)
     for regime in REGIMES:
         name = regime.replace("-", "_")
         hits = int((rows["regime"] == regime).sum())
@@ -165,6 +170,9 @@ def summarize(frame, by=None, seed=0):
           there, or failed; ``steady`` only where ``frame`` has ``stop_reason``, and
           unknown, ``<NA>``, where its sweep ran with ``--no-early-stop``:
           ``steady_tested``);
+        * ``unsteady`` and ``p_unsteady`` (with its Wilson interval): the rows still
+          moving at their end (``terminal_state``, ``loopsim.late_motion``), only where
+          every row of ``frame`` records it;
         * ``p_<regime>`` for each regime (stable, in_plane, 3d, failed), with its 95 %
           Wilson score interval ``p_<regime>_low``, ``p_<regime>_high``:
           (p̂ + z²/2N ± z sqrt(p̂(1 − p̂)/N + z²/4N²)) / (1 + z²/N), z = Φ⁻¹(0.975);

@@ -83,6 +83,7 @@ class CasesRun(typing.NamedTuple):
     status: np.ndarray  #: (B,) ``integrators.STATUS_NAMES`` codes
     counts: np.ndarray  #: (B, len(integrators.COUNTS)), summed over the levels
     worst: np.ndarray  #: (B, 2) largest length error and spectral tail of the last level
+    samples: list  #: B arrays (K, 3, 2 n_used + 1): the states at the sample times
 
 
 def integrate_case(method, g0, w, x0, t0, t_end, t_eval, options, ladder, tail_tol,
@@ -120,14 +121,16 @@ def integrate_case(method, g0, w, x0, t0, t_end, t_eval, options, ladder, tail_t
 
 
 def integrate_cases(method, parameters, x0, t_end, options, ladder, tail_tol, cost=None,
-                    model=models.LOCAL):
+                    model=models.LOCAL, sample_times=None):
     """Many cases of ``model`` up the ladder, each level in the parallel batch kernel, each
     order from t0.
 
     x0 (B, 3, 2 ladder[0] + 1); parameters (B, P) each case's
-    ``models.case_parameters``.  Returns a ``CasesRun`` (x_final,
-    n_used, t_final, status, counts, worst): x_final a list of B arrays (3, 2 n_used
-    + 1); counts summed over the levels; the others those of each case's last level.
+    ``models.case_parameters``; sample_times (B, K) or None (K = 0), sorted times within
+    [0, t_end] per case.  Returns a ``CasesRun`` (x_final, n_used, t_final, status,
+    counts, worst, samples): x_final a list of B arrays (3, 2 n_used + 1); counts summed
+    over the levels; the others those of each case's last level (samples: the states at
+    the sample times, from the driver's dense output).
     """
     cases = len(x0)
     x0 = [np.asarray(xb, dtype=float) for xb in x0]
@@ -140,6 +143,9 @@ def integrate_cases(method, parameters, x0, t_end, options, ladder, tail_tol, co
     counts = np.zeros((cases, len(integrators.COUNTS)), dtype=np.int64)
     worst = np.zeros((cases, 2))
     n_used = np.full(cases, ladder[0], dtype=np.int64)
+    sample_times = (np.zeros((cases, 0)) if sample_times is None else
+                    np.asarray(sample_times, dtype=float).reshape(cases, -1))
+    samples = [None] * cases
     for level, n in enumerate(ladder):
         active = np.flatnonzero(status == REFINE)
         if not active.size:
@@ -149,7 +155,7 @@ def integrate_cases(method, parameters, x0, t_end, options, ladder, tail_tol, co
                 method, models.case_constants(model, n), parameters[active],
                 np.array([spectral.resize(x0[b], n).ravel() for b in active]), t_end[active],
                 level_options(options, tail_tol, level == len(ladder) - 1),
-                cost=cost[active])
+                cost=cost[active], sample_times=sample_times[active])
         for row, b in enumerate(active):
             x[b] = level_run.y_final[row].reshape(3, -1)
             t[b] = level_run.t_final[row]
@@ -157,4 +163,6 @@ def integrate_cases(method, parameters, x0, t_end, options, ladder, tail_tol, co
             counts[b] += level_run.counts[row]
             worst[b] = level_run.worst[row][:2]
             n_used[b] = n
-    return CasesRun(x, n_used, t, status, counts, worst)
+            samples[b] = level_run.samples[row].reshape(sample_times.shape[1], 3,
+                                                        spectral.n_coeffs(n))
+    return CasesRun(x, n_used, t, status, counts, worst, samples)

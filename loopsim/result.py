@@ -5,7 +5,7 @@ import dataclasses
 
 import numpy as np
 
-from . import diagnostics, integrators, outcomes, storage
+from . import diagnostics, integrators, late_motion, outcomes, storage
 from .diagnostics import stability_parameter
 
 #: The keys of ``SimulationResult.summary()`` and of ``loopsim run --json``, in order:
@@ -68,6 +68,11 @@ class SimulationResult:
         Aspect ratio of the start (dimensionless).
     twin : dict or None
         The twin's end state and cost (``loopsim.outcomes``), None without a twin.
+    motion : dict or None
+        Whether the end is a terminal state, and the motion before it
+        (``loopsim.late_motion``): terminal_state ("steady", "quiet", "unsteady" or
+        "failed"), the late window's tilt (degrees) and aspect-ratio mean, min and max,
+        time_since_swing (t_u).
     compile_s : float
         Seconds of kernel compilation during the call.
     thresholds : loopsim.outcomes.Thresholds
@@ -125,6 +130,7 @@ class SimulationResult:
     initial_info: dict = None  # diagnostics of a given initial shape (``shapes``), else None
     aspect_ratio_initial: float = float("nan")
     twin: dict = None  # the twin's end state and cost (``outcomes``), or None without one
+    motion: dict = None  # the late-motion fields (``late_motion``)
     compile_s: float = 0.0  # kernel compilation during the call, not counted in wall_s
     thresholds: outcomes.Thresholds = outcomes.Thresholds()
 
@@ -181,6 +187,12 @@ class SimulationResult:
     def determined(self):
         return self.determinacy["determined"]
 
+    @property
+    def terminal_state(self):
+        """"steady", "quiet", "unsteady" or "failed" (``loopsim.late_motion``); None if not
+        measured."""
+        return None if self.motion is None else self.motion["terminal_state"]
+
     def __repr__(self):
         d = self.determinacy
         return (f"SimulationResult(g0={self.inputs['g0']:g}, theta0_deg="
@@ -192,7 +204,8 @@ class SimulationResult:
                 f"times={len(self.t)}, nfev={self.nfev}, wall_s={self.wall_s:.3g})")
 
     def warnings(self):
-        """Lines a user should read: the run is not resolved, or not determined."""
+        """Lines a user should read: the run is not resolved, not determined, or ended in
+        motion (``terminal_state`` "unsteady")."""
         lines = []
         if not self.resolved:
             lines.append(
@@ -209,6 +222,14 @@ class SimulationResult:
                 f"{d['aspect_uncertainty']:.2g} in aspect ratio away (regime "
                 f"{self.twin['regime']!r}): the terminal tilt is a sample of an "
                 "ill-conditioned transient, not an outcome")
+        if self.terminal_state == "unsteady":
+            m = self.motion
+            lines.append(
+                f"no terminal state: the loop still moves at t = {self.t_final:g} (tilt "
+                f"{m['late_tilt_min_deg']:.3g}-{m['late_tilt_max_deg']:.3g} deg, aspect ratio "
+                f"{m['late_aspect_min']:.3g}-{m['late_aspect_max']:.3g} over the last "
+                f"{late_motion.LATE_FRACTION:.0%} of the run): its terminal values are a "
+                "snapshot of the motion; integrate longer, or read the late-window statistics")
         return lines
 
     def tension_profile(self, i=None):
@@ -227,7 +248,8 @@ class SimulationResult:
             steps_accepted=self.steps_accepted, steps_rejected=self.steps_rejected,
             nfev=self.nfev, njev=self.njev, nlu=self.nlu, wall_s=self.wall_s,
             tail_max=self.tail_max, regime=self.regime, resolved=self.resolved,
-            **self.determinacy)
+            **self.determinacy,
+            **(self.motion or {name: None for name in storage.MOTION_FIELDS}))
 
 
 def terminal_summary(inputs, x, u, multiplier, **run_stats):

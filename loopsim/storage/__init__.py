@@ -28,13 +28,13 @@ from .seedsdir import (
     is_seeds_auto, read_results, read_seeds_auto, read_seeds_file, read_stop_table, round_directory,
 )
 from .tables import (
-    COEFFICIENT_LAYOUT, INPUT_FIELDS, OUTCOME_FIELDS, RESULT_SCHEMA, RUN_FIELDS, SUMMARY_FIELDS,
+    COEFFICIENT_LAYOUT, INPUT_FIELDS, MOTION_FIELDS, OUTCOME_FIELDS, RESULT_SCHEMA, RUN_FIELDS, SUMMARY_FIELDS,
     coefficients, described, provenance, read_metadata, trajectory_table, write_trajectory,
 )
 
 __all__ = [
     "CHUNK_PATTERN", "COEFFICIENT_LAYOUT", "CONTENT_KEY", "DamagedFile", "FINGERPRINT_IGNORES",
-    "INPUT_FIELDS", "LAYOUT", "OUTCOME_FIELDS", "QUARANTINE_DIR", "RERUN_DIR", "RESULT_SCHEMA",
+    "INPUT_FIELDS", "LAYOUT", "MOTION_FIELDS", "OUTCOME_FIELDS", "QUARANTINE_DIR", "RERUN_DIR", "RESULT_SCHEMA",
     "RUN_FIELDS", "SNAPSHOT_DIR", "SUMMARY_FIELDS", "SWEEP_FILE", "case_order",
     "check_files_belong", "check_layout", "check_no_overlap", "check_rows", "chunk_files",
     "coefficients", "config_fingerprint", "content_hash", "damaged_files", "described",

@@ -16,7 +16,7 @@ import pyarrow as pa
 
 from .. import columns
 from .integrity import CONTENT_KEY, DamagedFile, read_table_checked
-from .tables import RESULT_SCHEMA, read_metadata
+from .tables import MOTION_FIELDS, RESULT_SCHEMA, read_metadata
 
 
 #: A sweep directory is a Parquet dataset: result files ``chunk-SSSSSSS-EEEEEEE.parquet`` at
@@ -235,7 +235,8 @@ def requires_hash(stored):
 #: Columns added since result files were first written, with the value their rows had
 #: before (a file written earlier holds local-model rows without these columns).
 ADDED_COLUMNS = {"model": "local", "slenderness": None, "twin_regime": None,
-                 "twin_theta_final_deg": None, "twin_aspect_ratio": None}
+                 "twin_theta_final_deg": None, "twin_aspect_ratio": None,
+                 **{name: None for name in MOTION_FIELDS}}
 
 
 def result_table(table):

@@ -33,8 +33,12 @@ RUN_FIELDS = ("method", "n_used", "status", "t_final", "steps_accepted", "steps_
 OUTCOME_FIELDS = ("regime", "resolved", "determined", "theta_uncertainty_deg",
                   "aspect_uncertainty", "twin_nfev", "twin_regime", "twin_theta_final_deg",
                   "twin_aspect_ratio")
+#: Whether the end is a terminal state, and the motion before it (``loopsim.late_motion``).
+MOTION_FIELDS = ("terminal_state", "late_tilt_mean_deg", "late_tilt_min_deg",
+                 "late_tilt_max_deg", "late_aspect_mean", "late_aspect_min", "late_aspect_max",
+                 "time_since_swing")
 SUMMARY_FIELDS = (INPUT_FIELDS + RUN_FIELDS + tuple(d.name for d in diagnostics.REGISTRY)
-                  + OUTCOME_FIELDS)
+                  + OUTCOME_FIELDS + MOTION_FIELDS)
 
 _FLOAT = pa.float64()
 _INT = pa.int64()
@@ -43,7 +47,7 @@ _SUMMARY_TYPES = {
     "steps_accepted": _INT,
     "steps_rejected": _INT, "nfev": _INT, "njev": _INT, "nlu": _INT,
     "regime": pa.string(), "resolved": pa.bool_(), "determined": pa.bool_(), "twin_nfev": _INT,
-    "twin_regime": pa.string(),
+    "twin_regime": pa.string(), "terminal_state": pa.string(),
     **{d.name: pa.from_numpy_dtype(np.dtype(d.dtype)) for d in diagnostics.REGISTRY},
 }
 #: The declared schema of every sweep chunk (and of :func:`read_results`); each field

@@ -9,8 +9,8 @@ import numpy as np
 import pyarrow as pa
 
 from .. import (
-    _jitcache, api, columns, diagnostics, integrators, models, outcomes, refinement, shapes,
-    spectral, storage,
+    _jitcache, api, columns, diagnostics, integrators, late_motion, models, outcomes, refinement,
+    shapes, spectral, storage,
 )
 from .cases import case_model, case_option
 from .chunks import chunk_case_ids
@@ -44,10 +44,11 @@ def case_ladder(config, case):
 
 
 def _result_row(config, case_id, case, x0, x, status_code, counts, worst, wall_s, t_final,
-                method, twin=None):
+                method, motion, twin=None):
     """One row of RESULT_SCHEMA for a finished case with final coefficients x (3, 2 n_used + 1);
-    worst = (largest length error, largest spectral tail); ``twin``: the twin's end state
-    (``api.twin_end_state``) or None."""
+    worst = (largest length error, largest spectral tail); ``motion``: its late-motion
+    fields (``late_motion``); ``twin``: the twin's end state (``api.twin_end_state``) or
+    None."""
     n_used = (x.shape[1] - 1) // 2
     ok = status_code in integrators.SUCCESS
     end = outcomes.end_state(case["theta0_deg"], diagnostics.aspect_ratio(x0), x, ok,
@@ -68,7 +69,7 @@ def _result_row(config, case_id, case, x0, x, status_code, counts, worst, wall_s
         inputs, x, u, multiplier, method=method, n_used=n_used,
         status=integrators.STATUS_NAMES[status_code], t_final=t_final, wall_s=wall_s,
         tail_max=float(worst[1]), regime=end["regime"],
-        resolved=config.thresholds.resolved(worst[0], worst[1]), **determinacy,
+        resolved=config.thresholds.resolved(worst[0], worst[1]), **determinacy, **motion,
         **dict(zip(integrators.COUNTS, (int(c) for c in counts))))
     row.update(
         case_id=case_id, aspect_ratio_initial=diagnostics.aspect_ratio(x0),
@@ -99,7 +100,7 @@ def _traced_case(config, case_id):
     row = _result_row(config, case_id, case, result.x[0], result.x_final, result.status_code,
                       [getattr(result, name) for name in integrators.COUNTS],
                       (result.length_error_max, result.tail_max), result.wall_s,
-                      result.t_final, method, result.twin)
+                      result.t_final, method, result.motion, result.twin)
     table = storage.trajectory_table(result).replace_schema_metadata(None)
     for name in ("x", "multiplier"):  # orders differ between cases: variable-length lists
         table = table.set_column(table.schema.get_field_index(name), name,
@@ -119,6 +120,7 @@ class GroupRun(typing.NamedTuple):
 
     members: list  #: the cases' ids
     x0: list  #: their start shapes (3, 2n + 1)
+    sample_times: np.ndarray  #: (B, K) the times of their late-motion samples
     method: str  #: the integrator's name
     run: refinement.CasesRun  #: the runs
     twins: object  #: the twins' ``refinement.CasesRun``, or None without twins
@@ -173,6 +175,8 @@ def _run_group(config, key, members):
     model, _, method, rtol, twin = key
     cases = [config.cases[i] for i in members]
     x0 = [shapes.start_shape(**_start(c))[0] for c in cases]
+    sample_times = np.array([late_motion.sample_times(0.0, case_option(config, c, "t_end"))
+                             for c in cases])
     run = functools.partial(
         refinement.integrate_cases, integrators.METHODS[method],
         [models.case_parameters(model, c["g0"], config.w) for c in cases], x0,
@@ -181,14 +185,14 @@ def _run_group(config, key, members):
         cost=[diagnostics.stability_parameter(c["g0"], c["theta0_deg"]) for c in cases],
         model=model)
     options = config.step_options()._replace(rtol=float(rtol))
-    result = run(options=options, tail_tol=config.tail_tol)
+    result = run(options=options, tail_tol=config.tail_tol, sample_times=sample_times)
     twins = None
     if twin:
         twin_rtol, twin_atol, twin_tail = outcomes.twin_tolerances(
             options.rtol, options.atol, config.tail_tol)
         twins = run(options=options._replace(rtol=twin_rtol, atol=twin_atol),
                     tail_tol=twin_tail)
-    return GroupRun(members, x0, method, result, twins)
+    return GroupRun(members, x0, sample_times, method, result, twins)
 
 
 def _group_rows(config, group, wall, total_rhs):
@@ -204,10 +208,15 @@ def _group_rows(config, group, wall, total_rhs):
                 case["theta0_deg"], diagnostics.aspect_ratio(group.x0[b]), twins.x_final[b],
                 int(twins.status[b]) in integrators.SUCCESS, config.thresholds),
                 nfev=int(twins.counts[b, nfev]))
+        status = int(run.status[b])
+        motion = late_motion.late_motion(
+            group.sample_times[b], run.samples[b], 0.0, group.sample_times[b][-1],
+            float(run.t_final[b]), run.x_final[b],
+            status in integrators.SUCCESS, status == integrators.STEADY, config.thresholds)
         rows[case_id] = _result_row(
-            config, case_id, case, group.x0[b], run.x_final[b], int(run.status[b]),
+            config, case_id, case, group.x0[b], run.x_final[b], status,
             run.counts[b], run.worst[b], wall * run.counts[b, nfev] / total_rhs,
-            float(run.t_final[b]), group.method, twin)
+            float(run.t_final[b]), group.method, motion, twin)
     return rows
 
 
