@@ -239,7 +239,9 @@ CONVERGENCE_COLUMNS = {
         "" if not end else f": {end[1:]} end of its 95% Wilson interval"))
        for name, what in (("stable", "ending stable"), ("in_plane", "ending in-plane"),
                           ("3d", "ending 3D"),
-                          ("steady", "that reached a steady state before t_end"))
+                          ("steady", "that reached a steady state before t_end"),
+                          ("unsteady", "still moving at t_end (terminal_state unsteady; "
+                                       "NaN where the sweep's code did not record it)"))
        for end in ("", "_low", "_high")},
     "certain_regime": (TEXT, "the regime whose 95% Wilson lower bound is >= 0.8, if any "
                              "(loopsim.distribution_differences.certain)"),
@@ -253,6 +255,7 @@ CONVERGENCE_COLUMNS = {
     **_difference_columns("p_in_plane", PROBABILITY, "P(in-plane)"),
     **_difference_columns("p_3d", PROBABILITY, "P(3D)"),
     **_difference_columns("p_steady", PROBABILITY, "P(steady before t_end)"),
+    **_difference_columns("p_unsteady", PROBABILITY, "P(still moving at t_end)"),
     **{k: v for q in (25, 50, 75)
        for k, v in _difference_columns(f"tilt_q{q}", DEG, f"terminal tilt quantile {q}%")
        .items()},

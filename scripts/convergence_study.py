@@ -22,7 +22,10 @@ of the perturbation's variance).
 Each setting is one ``loopsim sweep`` per group of cells, run by the ``--loopsim``
 executable (a frozen install keeps a study on one version of the code: the sweeps record
 their configuration, not the code), in the order below, each resumable; ``--read-only``
-tabulates the sweeps that have finished.  The table (one row per cell and setting;
+tabulates the sweeps that have finished.  The code each sweep ran on is in
+``STUDY_COMMITS.json`` beside them: the 12° and 60° cells on one commit, the 18° cells
+(which alone record ``terminal_state``, ``loopsim.late_motion``) on a later one; within a
+cell every setting ran on the same code.  The table (one row per cell and setting;
 columns in COLUMNS below) compares every setting with ``default`` through
 ``loopsim.distribution_differences``: differences of the regime probabilities, of
 P(steady before t_end) and of the tilt quartiles, with 95 % intervals, the smallest
@@ -82,14 +85,19 @@ def cell_rows(frame):
     out = frame.assign(**{f"is_{r.replace('-', '_')}": frame["regime"].eq(r) for r in REGIMES})
     out["steady"] = frame["stop_reason"].eq("steady").astype("boolean")
     out.loc[frame["stop_reason"].isna(), "steady"] = pd.NA
+    out["unsteady"] = frame["terminal_state"].eq("unsteady").astype("boolean")
+    out.loc[frame["terminal_state"].isna(), "unsteady"] = pd.NA  # written before it existed
     return out
 
 
 def describe(rows):
     """Per-cell statistics of one setting."""
     out = dict(seeds=len(rows), failed=int(rows["regime"].eq("failed").sum()))
-    for name in [f"is_{r.replace('-', '_')}" for r in REGIMES] + ["steady"]:
+    for name in [f"is_{r.replace('-', '_')}" for r in REGIMES] + ["steady", "unsteady"]:
         values = rows[name].dropna().astype(bool)
+        if not len(values):  # not recorded (unsteady: sweeps on the older code)
+            out[f"p_{name}"] = out[f"p_{name}_low"] = out[f"p_{name}_high"] = np.nan
+            continue
         hits = int(values.sum())
         out[f"p_{name[3:] if name.startswith('is_') else name}"] = hits / max(len(values), 1)
         low, high = outcome_statistics.wilson_interval(hits, len(values))
@@ -116,8 +124,9 @@ def tabulate(frames):
             if setting != "default" and default is not None:
                 base = default[(default["g0"] == g0) & (default["theta0_deg"] == theta0)]
                 if len(base):
-                    row.update(dd.compare_samples(base, rows, ["is_in_plane", "is_3d",
-                                                               "steady"]))
+                    recorded = base["unsteady"].notna().any() and rows["unsteady"].notna().any()
+                    row.update(dd.compare_samples(base, rows, ["is_in_plane", "is_3d", "steady"]
+                                                  + (["unsteady"] if recorded else [])))
                     row["verdict"] = row["verdict"].split(" ")[0]
             table.append(row)
     return pd.DataFrame(table).sort_values(["theta0_deg", "g0", "setting"], ignore_index=True)
