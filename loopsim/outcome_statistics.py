@@ -233,14 +233,18 @@ def _regime_counts(rows):
 def outcome_counts(frame):
     """The counts of a results table (``read_results``) that ``loopsim sweep`` closes
     with: ``cases``; ``regimes`` ({regime: rows}); ``unresolved`` (rows not resolved at
-    their n) and ``undetermined`` (rows whose twin ends elsewhere), each with the regimes
-    among them (``unresolved_regimes``, ``undetermined_regimes``); ``failed`` (rows whose
-    ``status`` is not "ok")."""
+    their n), ``undetermined`` (rows whose twin ends elsewhere) and ``unsteady`` (rows
+    still moving at their end, ``terminal_state``), each with the regimes among them
+    (``unresolved_regimes``, ``undetermined_regimes``, ``unsteady_regimes``); ``failed``
+    (rows whose ``status`` is not "ok")."""
     unresolved = frame[~frame["resolved"].astype(bool)]
     undetermined = frame[frame["determined"].eq(False)]
+    unsteady = (frame[frame["terminal_state"].eq("unsteady")] if "terminal_state" in frame
+                else frame.iloc[:0])
     return dict(cases=len(frame), regimes=_regime_counts(frame), unresolved=len(unresolved),
                 unresolved_regimes=_regime_counts(unresolved), undetermined=len(undetermined),
-                undetermined_regimes=_regime_counts(undetermined),
+                undetermined_regimes=_regime_counts(undetermined), unsteady=len(unsteady),
+                unsteady_regimes=_regime_counts(unsteady),
                 failed=int((frame["status"] != "ok").sum()))
 
 

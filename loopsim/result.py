@@ -97,6 +97,9 @@ class SimulationResult:
         determined, theta_uncertainty_deg (degrees), aspect_uncertainty, twin_nfev.
     determined : bool or None
         Whether the twin agrees (None without a twin).
+    terminal_state : str or None
+        "steady", "quiet", "unsteady" (no terminal state: still moving) or "failed"
+        (``motion``).
 
     Examples
     --------

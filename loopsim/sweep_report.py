@@ -101,6 +101,9 @@ def _counts(counts, stopped):
              ("resolved", counts["cases"] - counts["unresolved"]),
              ("not determined (a twin ends elsewhere)", f"{counts['undetermined']} (regimes "
               f"among them: {_counts_text(counts['undetermined_regimes'])})"),
+             ("still moving at their end (terminal_state unsteady)",
+              f"{counts['unsteady']} (regimes among them: "
+              f"{_counts_text(counts['unsteady_regimes'])})"),
              ("failed", counts["failed"])]
     if stopped is not None:
         items.append(("points, why their seeds stopped", f"{stopped['points']}: "

@@ -370,7 +370,7 @@ def _run(args, backend):
 
 
 def _print_outcomes(counts, out, config, frame):
-    """The cases by regime, and those not resolved or not determined."""
+    """The cases by regime, and those not resolved, not determined or still moving."""
     print(f"{counts['cases']} cases in {out}: "
           + ", ".join(f"{k} {v}" for k, v in counts["regimes"].items()))
     if counts["unresolved"]:
@@ -387,6 +387,12 @@ def _print_outcomes(counts, out, config, frame):
               "tilt is a sample of an ill-conditioned transient, not an outcome (regimes "
               "among them: " + ", ".join(
                   f"{k} {v}" for k, v in counts["undetermined_regimes"].items()) + ")")
+    if counts.get("unsteady"):
+        print(f"{counts['unsteady']} of {counts['cases']} cases still MOVE at their end "
+              "(column 'terminal_state' unsteady): their terminal values are snapshots of "
+              "the motion; the late_* columns give its mean and range over the last fifth "
+              "of the run (or run them longer with --t-end) (regimes among them: " + ", ".join(
+                  f"{k} {v}" for k, v in counts["unsteady_regimes"].items()) + ")")
 
 
 def _print_seeds_auto(stopped, stops, out, config, targets):
