@@ -14,7 +14,8 @@ t_final] (the terminal state itself included as the window's last sample):
   (``--no-early-stop``) or still drifting below the steady test's resolution;
 * ``unsteady``: it moved by more within the window: no terminal state was reached, and
   the window's mean and range describe the motion instead;
-* ``failed``: the run failed.
+* ``failed``: the run failed (the window's statistics then describe the motion up to its
+  last finite state).
 
 ``time_since_swing`` is t_final minus the last sample time at which the tilt stood
 more than ``tilt_change_deg`` from its terminal value (t_final − t0 when it never did):
@@ -44,7 +45,8 @@ def sample_times(t0, t_end):
 
 
 def failed_motion():
-    """The late-motion fields of a failed run: no motion to describe."""
+    """The late-motion fields of a run failed before any finite sample: nothing to
+    describe."""
     return dict({name: math.nan for name in MOTION_FIELDS}, terminal_state="failed")
 
 
@@ -72,19 +74,21 @@ def late_motion(times, states, t0, t_end, t_final, x_final, ok, steady, threshol
     thresholds : loopsim.outcomes.Thresholds
         Their ``tilt_change_deg`` and ``shape_change`` separate quiet from unsteady.
     """
-    if not ok or not np.all(np.isfinite(x_final)):
-        return failed_motion()
     reached = np.asarray(times) < t_final
     tilt, aspect = diagnostics.tilts_and_aspect_ratios(np.asarray(states)[reached])
     keep = np.isfinite(tilt)
-    t = np.append(np.asarray(times)[reached][keep], t_final)
-    tilt = np.append(tilt[keep], diagnostics.tilt_deg(x_final))
-    aspect = np.append(aspect[keep], diagnostics.aspect_ratio(x_final))
-    late = t >= t_final - late_window(t0, t_end)
+    t, tilt, aspect = np.asarray(times)[reached][keep], tilt[keep], aspect[keep]
+    if np.all(np.isfinite(x_final)):  # a failed run's end may not be
+        t = np.append(t, t_final)
+        tilt = np.append(tilt, diagnostics.tilt_deg(x_final))
+        aspect = np.append(aspect, diagnostics.aspect_ratio(x_final))
+    if not t.size:
+        return failed_motion()
+    late = t >= t[-1] - late_window(t0, t_end)
     swings = t[np.abs(tilt - tilt[-1]) > thresholds.tilt_change_deg]
     moved = (np.ptp(tilt[late]) > thresholds.tilt_change_deg
              or np.ptp(aspect[late]) > thresholds.shape_change)
-    state = ("steady" if steady else
+    state = ("failed" if not ok else "steady" if steady else
              "unsteady" if moved else "quiet")
     return dict(terminal_state=state,
                 late_tilt_mean_deg=float(tilt[late].mean()),

@@ -104,9 +104,14 @@ def test_the_window_is_a_share_of_the_run():
 def test_steady_and_failed_runs():
     t = late_motion.sample_times(0.0, 10.0)
     assert motion(np.where(t < 9.5, 50.0, 30.0), steady=True)["terminal_state"] == "steady"
-    failed = motion(30.0, ok=False)
-    assert failed["terminal_state"] == "failed"
-    assert all(math.isnan(failed[k]) for k in storage.MOTION_FIELDS[1:])
+    failed = motion(30.0, ok=False)  # the motion up to the failure, still described
+    assert failed["terminal_state"] == "failed" and failed["late_tilt_max_deg"] == pytest.approx(30)
+    times = late_motion.sample_times(0.0, 10.0)
+    nothing = late_motion.late_motion(times, np.full((times.size, 3, 2 * N + 1), np.nan), 0.0,
+                                      10.0, 0.0, np.full((3, 2 * N + 1), np.nan), False, False,
+                                      THRESHOLDS)
+    assert nothing["terminal_state"] == "failed"
+    assert all(math.isnan(nothing[k]) for k in storage.MOTION_FIELDS[1:])
 
 
 def test_an_early_stop_judges_the_window_before_it():
