@@ -84,23 +84,41 @@ def detectable_probability_difference(p_a, trials_a, trials_b, power=POWER, z=Z9
     return float("nan")
 
 
+def bootstrap_quantile_differences(a, b, quantile, resamples=RESAMPLES, seed=0):
+    """(Δ, draws) for Q_b − Q_a, the ``quantile`` of the finite values of a and b: the
+    sample difference and ``resamples`` bootstrap draws of it (None, None if either
+    sample is empty)."""
+    a, b = np.asarray(a, float), np.asarray(b, float)
+    a, b = a[np.isfinite(a)], b[np.isfinite(b)]
+    if not (a.size and b.size):
+        return None, None
+    rng = np.random.default_rng(seed)
+    draws_a = np.quantile(a[rng.integers(0, a.size, (resamples, a.size))], quantile, axis=1)
+    draws_b = np.quantile(b[rng.integers(0, b.size, (resamples, b.size))], quantile, axis=1)
+    return float(np.quantile(b, quantile) - np.quantile(a, quantile)), draws_b - draws_a
+
+
+def percentile_interval(draws, level):
+    """The central ``level`` percentile interval of bootstrap draws, as (low, high)."""
+    tail = 100 * (1 - level) / 2
+    low, high = np.percentile(draws, [tail, 100 - tail])
+    return float(low), float(high)
+
+
+def detectable_from_draws(draws):
+    """The difference a bootstrap with these draws detects with POWER: (z_0.975 + z_POWER)
+    × their standard deviation."""
+    return float((norm.ppf(0.975) + norm.ppf(POWER)) * draws.std())
+
+
 def quantile_difference(a, b, quantile, resamples=RESAMPLES, seed=0, level=0.95):
     """(Δ, low, high, detectable) of Q_b − Q_a for the ``quantile`` of the finite values of
     a and b: percentile-bootstrap interval at ``level``; detectable = (z + z_POWER) × the
     bootstrap standard deviation."""
-    a, b = np.asarray(a, float), np.asarray(b, float)
-    a, b = a[np.isfinite(a)], b[np.isfinite(b)]
-    if not (a.size and b.size):
+    delta, draws = bootstrap_quantile_differences(a, b, quantile, resamples, seed)
+    if draws is None:
         return (float("nan"),) * 4
-    rng = np.random.default_rng(seed)
-    draws_a = np.quantile(a[rng.integers(0, a.size, (resamples, a.size))], quantile, axis=1)
-    draws_b = np.quantile(b[rng.integers(0, b.size, (resamples, b.size))], quantile, axis=1)
-    differences = draws_b - draws_a
-    tail = 100 * (1 - level) / 2
-    low, high = np.percentile(differences, [tail, 100 - tail])
-    detectable = (norm.ppf(0.975) + norm.ppf(POWER)) * differences.std()
-    return (float(np.quantile(b, quantile) - np.quantile(a, quantile)), float(low),
-            float(high), float(detectable))
+    return (delta, *percentile_interval(draws, level), detectable_from_draws(draws))
 
 
 def compare_samples(a, b, probabilities, quantiles=TILT_QUANTILES, seed=0):
@@ -147,12 +165,16 @@ def compare_samples(a, b, probabilities, quantiles=TILT_QUANTILES, seed=0):
         differs |= low > 0.0 or high < 0.0
     for i, quantile in enumerate(quantiles):
         name = f"delta_tilt_q{round(100 * quantile)}"
-        values = quantile_difference(a["theta_final_deg"], b["theta_final_deg"], quantile,
-                                     seed=seed + i)
-        out.update(zip((name, f"{name}_low", f"{name}_high", f"{name}_detectable"), values))
-        _, low, high, _ = quantile_difference(a["theta_final_deg"], b["theta_final_deg"],
-                                              quantile, seed=seed + i,
-                                              level=1 - 0.05 / statistics)
+        delta, draws = bootstrap_quantile_differences(
+            a["theta_final_deg"], b["theta_final_deg"], quantile, seed=seed + i)
+        if draws is None:
+            out.update({name: np.nan, **{f"{name}_{k}": np.nan
+                                         for k in ("low", "high", "detectable")}})
+            continue
+        out[name] = delta
+        out[f"{name}_low"], out[f"{name}_high"] = percentile_interval(draws, 0.95)
+        out[f"{name}_detectable"] = detectable_from_draws(draws)
+        low, high = percentile_interval(draws, 1 - 0.05 / statistics)  # the same draws
         differs |= bool(low > 0.0 or high < 0.0)
     out["verdict"] = DIFFERENT if differs else SAME
     return out
