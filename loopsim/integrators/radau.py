@@ -22,8 +22,7 @@ with a stale one; a failed Newton cuts h by NEWTON_FAILURE_FACTOR.  Unlike
 theirs, the Jacobian is not taken at y but inside the step it serves, at
 JACOBIAN_POINT of it on the last step's collocation polynomial (at y only on the
 first step): on a tumbling loop J moves enough within a step for the frozen-J
-iteration to diverge in the high modes, and this point cut the priced cost by
-12-38 % (JACOBIAN_POINT).
+iteration to diverge in the high modes (measurements at JACOBIAN_POINT).
 
 Step control (:func:`step_proposal`) takes the smaller of two limits.  The
 error limit is Gustafsson's predictive controller on the filtered estimate
@@ -103,9 +102,12 @@ NOISE_MARGIN = 10.0
 #: about to be taken; :func:`jacobian_state`), 0 meaning at y (Hairer's and scipy's
 #: radau5).  The stages sit at c = 0.155, 0.645, 1 of the step: a Jacobian there rather
 #: than at its start is the one the simplified Newton iteration of that step needs.
-#: Measured (issue 44) on a tumbling loop, (350, 18°, 32), whose Jacobian moves 6-21 %
-#: per 1e-3 of time: the priced cost fell to 0.62-0.76x at rtol 1e-3, 0.71-0.88x at 1e-6
-#: on four windows (benchmarks/bench_tumbling.py).
+#: Measured on the tumbling loop (350, 18°, 32) (benchmarks/bench_tumbling.py): over
+#: t in [0, 0.5] and [1, 1.3], nfev 0.56-0.64x at rtol 1e-3 and 0.92-0.93x at 1e-6,
+#: Jacobians 0.64-0.79x, priced cost 0.61-0.85x, wall time 0.56-0.91x; at equal end-state
+#: error over 0.1 t_u 0.56-0.74x.  On the well-posed cases of bench_step_control.py, 0.83x
+#: at equal terminal-tilt error, at most 1 % more RHS evaluations (one F per Jacobian, at
+#: its point).  Points from 0.5 to 1 do about as well (docs/development-notes-levers.md).
 JACOBIAN_POINT = 0.578
 
 #: The method as data: its error order and the policy constants above.
