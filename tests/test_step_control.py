@@ -126,9 +126,9 @@ def test_the_newton_limit_ignores_rates_measured_in_the_noise():
     assert converged and rate >= 0 and limit_rate == -1.0
 
 
-#: Compiled unit costs in RHS evaluations at n = 32 (issue 44: F 0.11 ms, J 3.5 ms, the
-#: LU pair 1.6 ms), to weigh counts into one cost.
-J_IN_F, LU_PAIR_IN_F = 31, 15
+#: Compiled unit costs in RHS evaluations at n = 32 on an idle machine (docs/performance.md:
+#: F 0.11 ms, J 3.7 ms, the LU pair 1.5 ms), to weigh counts into one cost.
+J_IN_F, LU_PAIR_IN_F = 34, 14
 
 
 def priced_counts(g0, theta0, n, t_end, rtol, point):
@@ -154,9 +154,10 @@ def test_the_jacobian_inside_the_step_costs_no_more_than_at_y(case):
     """The Jacobian at RADAU5.jacobian_point of the step (on the last step's collocation
     polynomial) against at y (jacobian_point 0, Hairer's and scipy's): no more Jacobians,
     LU factorisations or priced cost at rtol 1e-3 and 1e-6, on a well-posed flipping loop
-    and on the start of a tumbling one (issue 44: (350, 18°, 32) priced 0.62-0.88x).
-    Measured (cost in F): 9 469 -> 7 633 at rtol 1e-3 and 24 030 -> 20 846 at 1e-6 on the
-    first, 2 529 -> 1 937 and 5 319 -> 4 262 on the second."""
+    and on the start of a tumbling one (at (350, 18°, 32) priced 0.61-0.85x,
+    benchmarks/bench_tumbling.py).
+    Measured (cost in F): 9 742 -> 7 823 at rtol 1e-3 and 24 700 -> 21 378 at 1e-6 on the
+    first, 2 577 -> 1 971 and 5 441 -> 4 336 on the second."""
     assert R.RADAU5.jacobian_point > 0.0
     for rtol in (1e-3, 1e-6):
         old = priced_counts(*case, rtol, 0.0)
