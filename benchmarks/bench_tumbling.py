@@ -10,12 +10,12 @@ unit costs, in one process.
 The loop: (g0, θ0) = (350, 18°), seed 0, n = 32, the default perturbation: it tumbles, and
 accurate runs of it part x10 every ~0.04 t_u (a finite-time Lyapunov exponent of ~60 per
 t_u, issue 44).  Windows (``--windows START:END,...``; default [0, 0.1], [1, 1.1] and
-[2, 2.1]) start at t = 0 from the seeded start (``shapes.start_shape``,
-as ``loopsim run --g0 350 --theta0 18 --n 32`` builds it) or at later times from the states
-recorded in ``benchmarks/tumbling_start.json`` (at t = 0.5, 1, 1.5 and 2, from one radau5
-run from t = 0 at rtol 1e-8, by its dense output; ``--record-start`` runs it again and
-rewrites the file).  Windows longer
-than ``--accuracy-length`` are counted and timed only.
+[2, 2.1]) start at t = 0 from the seeded start (``shapes.start_shape``, as ``loopsim run
+--g0 350 --theta0 18 --n 32`` builds it) or at later times from the states recorded in
+``benchmarks/tumbling_start.json`` (at t = 0.5, 1, 1.5 and 2, from one radau5 run from
+t = 0 at rtol 1e-8, by its dense output; ``--record-start`` runs it again and rewrites the
+file; the loop tumbles at t = 0.5-1.5 and is calm at t = 2).  Windows longer than
+``--accuracy-length`` are counted and timed only.
 
 For each window, rtol (``--rtols``, atol = rtol / 1000) and Jacobian point (``--points``):
 radau5's counts (steps, rejected, nfev, njev, nlu), its priced cost and its wall time (the
