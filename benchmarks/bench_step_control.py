@@ -2,7 +2,7 @@
 
 Usage: python benchmarks/bench_step_control.py [--cases 150:45:16,100:60:16,150:45:21,100:60:24]
            [--rtols 1e-3,...,1e-12] [--t-end 2] [--atol-ratio 1e-3 | --atol A]
-           [--ref-rtol 1e-13] [--refs OLD.json] [--out FILE.json]
+           [--ref-rtol 1e-13] [--refs OLD.json] [--jacobian-point P] [--out FILE.json]
 
 For each case (g0:θ0:n) it runs ``loopsim.simulate(method="radau5", twin=False)`` from the
 seeded start (perturbation 1e-3, seed 0) over t ≤ t_end at every rtol, atol = rtol ×
@@ -17,6 +17,8 @@ next tighter one.
 ``--refs OLD.json`` takes the reference tilts from an earlier run's file instead of
 computing them, so that two versions of the code are measured against the same
 reference (nfev and the step counts are deterministic; wall times are not).
+``--jacobian-point P`` runs radau5 with that Jacobian policy (``RadauIIA.jacobian_point``;
+0: at y, as before issue 44) instead of the default, references included.
 """
 import argparse
 import json
@@ -24,7 +26,7 @@ import time
 import warnings
 
 import loopsim
-from loopsim import api, diagnostics
+from loopsim import api, diagnostics, integrators
 
 CASES = "150:45:16,100:60:16,150:45:21,100:60:24"
 RTOLS = "1e-3,1e-4,1e-5,1e-6,1e-7,1e-8,1e-9,1e-10,1e-11,1e-12"
@@ -49,8 +51,13 @@ def main():
     parser.add_argument("--atol", type=float, help="a fixed atol instead of --atol-ratio")
     parser.add_argument("--ref-rtol", type=float, default=1e-13)
     parser.add_argument("--refs", help="take the reference tilts from this earlier --out file")
+    parser.add_argument("--jacobian-point", type=float,
+                        help="radau5's RadauIIA.jacobian_point (default: the method's)")
     parser.add_argument("--out", help="write the rows and references as JSON")
     args = parser.parse_args()
+    if args.jacobian_point is not None:  # simulate(method="radau5") looks the method up here
+        integrators.METHODS["radau5"] = integrators.RADAU5._replace(
+            jacobian_point=args.jacobian_point)
     cases = [(float(g0), float(theta0), int(n)) for g0, theta0, n in
              (c.split(":") for c in args.cases.split(","))]
     rtols = [float(v) for v in args.rtols.split(",")]
@@ -94,7 +101,8 @@ def main():
     if args.out:
         with open(args.out, "w") as handle:
             json.dump(dict(t_end=args.t_end, atol_ratio=args.atol_ratio, atol=args.atol,
-                           ref_rtol=args.ref_rtol, references=refs, rows=rows), handle, indent=1)
+                           ref_rtol=args.ref_rtol,
+                           jacobian_point=integrators.METHODS["radau5"].jacobian_point, references=refs, rows=rows), handle, indent=1)
 
 
 if __name__ == "__main__":

@@ -124,3 +124,58 @@ def test_the_newton_limit_ignores_rates_measured_in_the_noise():
     converged, iterations, rate, limit_rate = R.solve_collocation(
         problem, y, h, z, scale, tol, 1e-3, 50, lu_r, piv_r, lu_c, piv_c, *work)
     assert converged and rate >= 0 and limit_rate == -1.0
+
+
+#: Compiled unit costs in RHS evaluations at n = 32 on an idle machine (docs/performance.md:
+#: F 0.11 ms, J 3.7 ms, the LU pair 1.5 ms), to weigh counts into one cost.
+J_IN_F, LU_PAIR_IN_F = 34, 14
+
+
+def priced_counts(g0, theta0, n, t_end, rtol, point):
+    """radau5 with ``jacobian_point`` = point from the seeded start: (cost in RHS
+    evaluations, nfev, njev, nlu)."""
+    import numpy as np
+    from loopsim import defaults, integrators, shapes
+    from loopsim.models import local_sbt
+
+    problem = local_sbt.make_problem(n, g0, defaults.DEFAULT_W)
+    x0 = shapes.initial_shape(n, np.radians(theta0), defaults.DEFAULT_PERTURBATION, 0)
+    method = integrators.RADAU5._replace(jacobian_point=point)
+    status, _, _, counts, _ = integrators.integrate(
+        method, problem, x0.reshape(-1).copy(), 0.0, t_end, None,
+        integrators.step_options(rtol, rtol * 1e-3), None)
+    assert status == control.OK
+    nfev, njev, nlu = (int(c) for c in counts[2:])
+    return nfev + J_IN_F * njev + LU_PAIR_IN_F * nlu, nfev, njev, nlu
+
+
+@pytest.mark.parametrize("case", [(150, 45, 12, 0.5), (350, 18, 16, 0.1)])
+def test_the_jacobian_inside_the_step_costs_no_more_than_at_y(case):
+    """The Jacobian at RADAU5.jacobian_point of the step (on the last step's collocation
+    polynomial) against at y (jacobian_point 0, Hairer's and scipy's): no more Jacobians,
+    LU factorisations or priced cost at rtol 1e-3 and 1e-6, on a well-posed flipping loop
+    and on the start of a tumbling one (at (350, 18°, 32) priced 0.61-0.85x,
+    benchmarks/bench_tumbling.py).
+    Measured (cost in F): 9 742 -> 7 823 at rtol 1e-3 and 24 700 -> 21 378 at 1e-6 on the
+    first, 2 577 -> 1 971 and 5 441 -> 4 336 on the second."""
+    assert R.RADAU5.jacobian_point > 0.0
+    for rtol in (1e-3, 1e-6):
+        old = priced_counts(*case, rtol, 0.0)
+        new = priced_counts(*case, rtol, R.RADAU5.jacobian_point)
+        assert new[0] <= old[0] and new[2] <= old[2] and new[3] <= old[3], (rtol, old, new)
+
+
+def test_the_jacobian_state_is_the_last_steps_polynomial_extrapolated():
+    """jacobian_state(y, q, r) = y + Σ_k q_k ((1 + r)^(k+1) - 1), against NumPy's
+    polynomial evaluation; y itself at r = 0."""
+    import numpy as np
+
+    rng = np.random.default_rng(1)
+    y, q = rng.normal(size=5), rng.normal(size=(3, 5))
+    out = np.empty(5)
+    for ratio in (0.0, 0.3, 0.578 * 2.5):
+        R.jacobian_state(y, q, ratio, out)
+        x = 1.0 + ratio
+        expected = y + np.polynomial.polynomial.polyval(x, np.vstack([np.zeros(5), q]))
+        expected -= np.polynomial.polynomial.polyval(1.0, np.vstack([np.zeros(5), q]))
+        np.testing.assert_allclose(out, expected, rtol=1e-13, atol=1e-13)

@@ -18,7 +18,11 @@ J comes from ``models.jacobian`` (exact for every model; for the loop it is
 Radau (Hairer's policies): the LU factors are kept while h does not change (h
 is held unless it should grow by ≥ HOLD_FACTOR or shrink), the Jacobian is
 refreshed after a slowly converging Newton iteration or when Newton fails
-with a stale one; a failed Newton cuts h by NEWTON_FAILURE_FACTOR.
+with a stale one; a failed Newton cuts h by NEWTON_FAILURE_FACTOR.  Unlike
+theirs, the Jacobian is not taken at y but inside the step it serves, at
+JACOBIAN_POINT of it on the last step's collocation polynomial (at y only on the
+first step): on a tumbling loop J moves enough within a step for the frozen-J
+iteration to diverge in the high modes (measurements at JACOBIAN_POINT).
 
 Step control (:func:`step_proposal`) takes the smaller of two limits.  The
 error limit is Gustafsson's predictive controller on the filtered estimate
@@ -93,14 +97,27 @@ ROUNDOFF_FLOOR = 1.0
 #: A contraction rate counts for the Newton limit only when measured from a correction
 #: above NOISE_MARGIN times the corrections' rounding (:func:`rounding_noise`).
 NOISE_MARGIN = 10.0
+#: Where the Jacobian is evaluated, as a fraction of the step it is for: at the last
+#: accepted step's collocation polynomial extrapolated to t + JACOBIAN_POINT h (h the step
+#: about to be taken; :func:`jacobian_state`), 0 meaning at y (Hairer's and scipy's
+#: radau5).  The stages sit at c = 0.155, 0.645, 1 of the step: a Jacobian there rather
+#: than at its start is the one the simplified Newton iteration of that step needs.
+#: Measured on the tumbling loop (350, 18°, 32) (benchmarks/bench_tumbling.py): over
+#: t in [0, 0.5] and [1, 1.3], nfev 0.56-0.64x at rtol 1e-3 and 0.92-0.93x at 1e-6,
+#: Jacobians 0.64-0.79x, priced cost 0.61-0.85x, wall time 0.56-0.91x; at equal end-state
+#: error over 0.1 t_u 0.56-0.74x.  On the well-posed cases of bench_step_control.py, 0.83x
+#: at equal terminal-tilt error, at most 1 % more RHS evaluations (one F per Jacobian, at
+#: its point).  Points from 0.5 to 1 do about as well (docs/development-notes-levers.md).
+JACOBIAN_POINT = 0.578
 
 #: The method as data: its error order and the policy constants above.
 RadauIIA = collections.namedtuple(
     "RadauIIA", "error_order newton_maxiter jacobian_iterations jacobian_rate hold_factor "
-    "newton_failure_factor rate_target rate_order rejected_growth roundoff_floor")
+    "newton_failure_factor rate_target rate_order rejected_growth roundoff_floor "
+    "jacobian_point")
 RADAU5 = RadauIIA(ERROR_ORDER, NEWTON_MAXITER, JACOBIAN_ITERATIONS, JACOBIAN_RATE, HOLD_FACTOR,
                   NEWTON_FAILURE_FACTOR, NEWTON_RATE_TARGET, NEWTON_RATE_ORDER, REJECTED_GROWTH,
-                  ROUNDOFF_FLOOR)
+                  ROUNDOFF_FLOOR, JACOBIAN_POINT)
 
 
 def _transformation():
@@ -150,6 +167,16 @@ def extrapolated_guess(q, ratio, z):
         for i in range(z.shape[1]):
             z[r, i] = (q[0, i] * (x - 1.0) + q[1, i] * (x * x - 1.0)
                        + q[2, i] * (x * x * x - 1.0))
+
+
+@kernel
+def jacobian_state(y, q, ratio, out):
+    """out = the last step's collocation polynomial (``q``, step h_old, ending at y) at
+    t + ratio h_old: y + Σ_k q_k ((1 + ratio)^(k+1) − 1); out = y for ratio 0."""
+    x = 1.0 + ratio
+    for i in range(y.shape[0]):
+        out[i] = y[i] + (q[0, i] * (x - 1.0) + q[1, i] * (x * x - 1.0)
+                         + q[2, i] * (x * x * x - 1.0))
 
 
 # ---- Newton matrices, iteration and error estimate -----------------------
@@ -297,9 +324,29 @@ def error_weights(y, y_new, rtol, atol, floor, scale):
 #: (indices below, stored as float64).
 RadauWork = collections.namedtuple(
     "RadauWork", "scale work_y work_f err real_rhs complex_rhs z poly w fz jac lu_real "
-    "lu_complex piv_real piv_complex scalars")
+    "lu_complex piv_real piv_complex scalars jac_y jac_f")
 (H_LU, H_OLD, ERR_OLD, REJECTED, JAC_CURRENT, NEWTON_TOL, ERR_NORM, RECOMPUTE_JAC, JACOBIANS,
- FACTORISATIONS, JAC_PENDING) = range(11)
+ FACTORISATIONS, JAC_PENDING, H_NEXT) = range(12)
+
+
+@kernel(inline=True)  # in the step attempt, which held the Jacobian's calls before
+def refresh_jacobian(method, work, problem, y, f, h):
+    """work.jac = J for a step of size h from y (f = F(y)), at ``method.jacobian_point``
+    of it on the last accepted step's collocation polynomial (:func:`jacobian_state`);
+    at y before the first accepted step or with jacobian_point 0.  Returns the RHS
+    evaluations (J's own, and F at that point)."""
+    s = work.scalars
+    evals = 0
+    if method.jacobian_point > 0.0 and s[H_OLD] > 0.0:
+        jacobian_state(y, work.poly, method.jacobian_point * h / s[H_OLD], work.jac_y)
+        rhs(problem, work.jac_y, work.jac_f)  # models.jacobian is given F at its point
+        evals = 1
+    else:
+        for i in range(y.shape[0]):
+            work.jac_y[i] = y[i]
+            work.jac_f[i] = f[i]
+    s[JACOBIANS] += 1.0
+    return evals + jacobian(problem, work.jac_y, work.jac_f, work.jac, work.work_y, work.work_f)
 
 
 @implements(start, RadauIIA)
@@ -310,7 +357,7 @@ def _radau_start(method, problem, y, f, options):
         np.empty(n, dtype=np.complex128), np.zeros((3, n)), np.zeros((3, n)),
         np.empty((3, n)), np.empty((3, n)), np.empty((n, n)), np.empty((n, n)),
         np.empty((n, n), dtype=np.complex128), np.empty(n, dtype=PIVOT_DTYPE),
-        np.empty(n, dtype=PIVOT_DTYPE), np.zeros(11))
+        np.empty(n, dtype=PIVOT_DTYPE), np.zeros(12), np.empty(n), np.empty(n))
     s = work.scalars
     s[JAC_PENDING] = 1.0  # the Jacobian at y: the driver's catch-up call evaluates it next
     s[H_LU] = -1.0
@@ -327,11 +374,11 @@ def _radau_start(method, problem, y, f, options):
 def _radau_attempt(method, work, problem, y, f, h, y_new, options):
     n = y.shape[0]
     s = work.scalars
-    if h < 0.0:  # base.CATCH_UP: the Jacobian start or advance asked for at (y, f)
+    if h < 0.0:  # base.CATCH_UP: the Jacobian start or advance asked for, for the next step
         evals = 0
         if s[JAC_PENDING] != 0.0:
-            evals = jacobian(problem, y, f, work.jac, work.work_y, work.work_f)
-            s[JACOBIANS] += 1.0
+            evals = refresh_jacobian(method, work, problem, y, f,
+                                     min(s[H_NEXT], options.max_step))
             s[JAC_PENDING] = 0.0
         return True, 0.0, evals
     f_max = 0.0
@@ -358,8 +405,7 @@ def _radau_attempt(method, work, problem, y, f, h, y_new, options):
         evals += 3 * iterations
         if converged or s[JAC_CURRENT] != 0.0:
             break
-        evals += jacobian(problem, y, f, work.jac, work.work_y, work.work_f)
-        s[JACOBIANS] += 1.0
+        evals += refresh_jacobian(method, work, problem, y, f, h)
         s[JAC_CURRENT] = 1.0
         s[H_LU] = -1.0
     if not converged:
@@ -398,12 +444,13 @@ def _radau_attempt(method, work, problem, y, f, h, y_new, options):
 def _radau_advance(method, work, problem, y, f, h, h_proposal):
     s = work.scalars
     if s[RECOMPUTE_JAC] != 0.0:
-        s[JAC_PENDING] = 1.0  # evaluated at y by the driver's catch-up call, next
+        s[JAC_PENDING] = 1.0  # evaluated for h_proposal by the driver's catch-up call, next
         s[JAC_CURRENT] = 1.0
         s[H_LU] = -1.0
     else:
         s[JAC_CURRENT] = 0.0
     s[H_OLD] = h
+    s[H_NEXT] = h_proposal
     s[ERR_OLD] = s[ERR_NORM]
     return h_proposal, 0
 
