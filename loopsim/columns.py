@@ -231,8 +231,8 @@ CONVERGENCE_COLUMNS = {
     "g0": RESULT_COLUMNS["g0"],
     "theta0_deg": RESULT_COLUMNS["theta0_deg"],
     "q0": RESULT_COLUMNS["q0"],
-    "setting": (TEXT, "default, rtol1e-8, n40 or amp1e-4 (the sweep options: the table's "
-                      "metadata, loopsim_convergence)"),
+    "setting": (TEXT, "default, rtol1e-8, n40, amp1e-4 or jmid (the sweep options: the "
+                      "table's metadata, loopsim_convergence; the code: STUDY_COMMITS.json)"),
     "seeds": (COUNT, "seeds of the cell at this setting"),
     "failed": (COUNT, "of them, runs that failed"),
     **{f"p_{name}{end}": (PROBABILITY, f"share of the seeds {what}" + (

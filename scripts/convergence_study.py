@@ -11,7 +11,9 @@ a distribution, not an outcome):
 * ``default``:  ``--n auto`` (radau5, rtol 1e-6, atol 1e-9, n up to 32);
 * ``rtol1e-8``: the same at ``--rtol 1e-8 --atol 1e-11``;
 * ``n40``:      ``--n 40 --method radau5`` (rtol 1e-6);
-* ``amp1e-4``:  ``--n auto --perturbation 1e-4`` (three cells).
+* ``amp1e-4``:  ``--n auto --perturbation 1e-4`` (three cells);
+* ``jmid``:     the defaults on the code whose radau5 takes its Jacobian inside the step
+  (29b7d79), at (350, 18°): the same answer in distribution at a lower cost per sample?
 
 The ensemble is loopsim's seeded perturbation (``loopsim.shapes.circle``): RMS size 1e-3
 (1e-4 for ``amp1e-4``) in modes 2 to the starting order with amplitudes drawn as N(0, 1)/k²,
@@ -53,6 +55,7 @@ SETTINGS = {
     "rtol1e-8": ["--n", "auto", "--rtol", "1e-8", "--atol", "1e-11"],
     "n40": ["--n", "40", "--method", "radau5"],
     "amp1e-4": ["--n", "auto", "--perturbation", "1e-4"],
+    "jmid": ["--n", "auto"],  # the defaults, on the code with radau5's Jacobian inside the step
 }
 #: (sweep name, setting, g0 values, θ0) in the order they run.
 SWEEPS = (
@@ -67,6 +70,7 @@ SWEEPS = (
     ("default_t18", "default", f"{G0[14]!r},{G0[13]!r}", "18"),
     ("rtol1e-8_t18", "rtol1e-8", f"{G0[14]!r},{G0[13]!r}", "18"),
     ("n40_t18", "n40", f"{G0[14]!r},{G0[13]!r}", "18"),
+    ("jmid_t18", "jmid", repr(float(G0[14])), "18"),
 )
 ENSEMBLE = ("loopsim's seeded perturbation (loopsim.shapes.circle): seeds 0-15, RMS size "
             "1e-3 (1e-4 for amp1e-4) in modes 2 to the starting order (6 with --n auto, "
