@@ -214,8 +214,8 @@ STOP_COLUMNS = {
 
 
 def _difference_columns(stat, unit, what):
-    """The four columns of one difference (setting − default) in a convergence table."""
-    return {f"delta_{stat}": (unit, f"{what}: this setting's minus the default's"),
+    """The four columns of one difference (setting − baseline) in a convergence table."""
+    return {f"delta_{stat}": (unit, f"{what}: this setting's minus its baseline's"),
             f"delta_{stat}_low": (unit, "lower end of its 95% interval (Newcombe for a "
                                         "probability, percentile bootstrap for a quantile)"),
             f"delta_{stat}_high": (unit, "upper end of its 95% interval"),
@@ -225,14 +225,19 @@ def _difference_columns(stat, unit, what):
 
 #: name: (unit, description) of every column of the convergence table
 #: (``scripts/convergence_study.py``, ``data/convergence_top.parquet``): one row per cell
-#: and setting; the ``delta_*`` columns compare the setting with the default one
-#: (``loopsim.distribution_differences``; empty on the default's own rows).
+#: and setting; the ``delta_*`` columns compare the setting with its baseline, the
+#: defaults on the same code (``loopsim.distribution_differences``; empty on the
+#: default's own rows).
 CONVERGENCE_COLUMNS = {
     "g0": RESULT_COLUMNS["g0"],
     "theta0_deg": RESULT_COLUMNS["theta0_deg"],
     "q0": RESULT_COLUMNS["q0"],
-    "setting": (TEXT, "default, rtol1e-8, n40, amp1e-4 or jmid (the sweep options: the "
-                      "table's metadata, loopsim_convergence; the code: STUDY_COMMITS.json)"),
+    "setting": (TEXT, "default, rtol1e-8, n40, amp1e-4, jmid, jmid_rtol1e-8 or jmid_n40 "
+                      "(the sweep options: the table's metadata, loopsim_convergence; the "
+                      "code: STUDY_COMMITS.json)"),
+    "baseline": (TEXT, "the setting the delta_* columns compare this one with: the "
+                       "defaults on the same code (default, or jmid for jmid_*); empty on "
+                       "the default's rows"),
     "seeds": (COUNT, "seeds of the cell at this setting"),
     "failed": (COUNT, "of them, runs that failed"),
     **{f"p_{name}{end}": (PROBABILITY, f"share of the seeds {what}" + (
@@ -260,7 +265,7 @@ CONVERGENCE_COLUMNS = {
        for k, v in _difference_columns(f"tilt_q{q}", DEG, f"terminal tilt quantile {q}%")
        .items()},
     "verdict": (TEXT, "different (a Bonferroni interval excludes 0) or same (within the "
-                      "intervals); empty on the default's rows"),
+                      "intervals), against the baseline; empty on the default's rows"),
 }
 
 

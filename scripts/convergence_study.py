@@ -14,6 +14,8 @@ a distribution, not an outcome):
 * ``amp1e-4``:  ``--n auto --perturbation 1e-4`` (three cells);
 * ``jmid``:     the defaults on the code whose radau5 takes its Jacobian inside the step
   (29b7d79), at (350, 18°): the same answer in distribution at a lower cost per sample?
+* ``jmid_rtol1e-8``, ``jmid_n40``: ``rtol1e-8`` and ``n40`` on that code, at the 18° cells,
+  compared with ``jmid`` (the defaults on the same code) rather than with ``default``.
 
 The ensemble is loopsim's seeded perturbation (``loopsim.shapes.circle``): RMS size 1e-3
 (1e-4 for ``amp1e-4``) in modes 2 to the starting order with amplitudes drawn as N(0, 1)/k²,
@@ -56,7 +58,12 @@ SETTINGS = {
     "n40": ["--n", "40", "--method", "radau5"],
     "amp1e-4": ["--n", "auto", "--perturbation", "1e-4"],
     "jmid": ["--n", "auto"],  # the defaults, on the code with radau5's Jacobian inside the step
+    "jmid_rtol1e-8": ["--n", "auto", "--rtol", "1e-8", "--atol", "1e-11"],
+    "jmid_n40": ["--n", "40", "--method", "radau5"],
 }
+#: the setting each one is compared with: the defaults on the same code (``default``
+#: where not named)
+BASELINE = {"jmid_rtol1e-8": "jmid", "jmid_n40": "jmid"}
 #: (sweep name, setting, g0 values, θ0) in the order they run.
 SWEEPS = (
     ("default_t12", "default", G12, "12"),
@@ -71,6 +78,11 @@ SWEEPS = (
     ("rtol1e-8_t18", "rtol1e-8", f"{G0[14]!r},{G0[13]!r}", "18"),
     ("n40_t18", "n40", f"{G0[14]!r},{G0[13]!r}", "18"),
     ("jmid_t18", "jmid", repr(float(G0[14])), "18"),
+    ("jmid_rtol1e-8_t18", "jmid_rtol1e-8", repr(float(G0[14])), "18"),
+    ("jmid_n40_t18", "jmid_n40", repr(float(G0[14])), "18"),
+    ("jmid_t18_326", "jmid", repr(float(G0[13])), "18"),
+    ("jmid_rtol1e-8_t18_326", "jmid_rtol1e-8", repr(float(G0[13])), "18"),
+    ("jmid_n40_t18_326", "jmid_n40", repr(float(G0[13])), "18"),
 )
 ENSEMBLE = ("loopsim's seeded perturbation (loopsim.shapes.circle): seeds 0-15, RMS size "
             "1e-3 (1e-4 for amp1e-4) in modes 2 to the starting order (6 with --n auto, "
@@ -118,13 +130,15 @@ def describe(rows):
 
 
 def tabulate(frames):
-    """One row per cell and setting; the comparisons with ``default``."""
+    """One row per cell and setting; the comparisons with each setting's baseline."""
     table = []
-    default = frames.get("default")
     for setting, frame in frames.items():
+        name = BASELINE.get(setting, "default")
         for (g0, theta0), rows in frame.groupby(["g0", "theta0_deg"]):
             row = dict(g0=g0, theta0_deg=theta0, q0=g0 * np.sin(np.radians(theta0)) / 3,
-                       setting=setting, **describe(rows))
+                       setting=setting, baseline=None if setting == "default" else name,
+                       **describe(rows))
+            default = frames.get(name)
             if setting != "default" and default is not None:
                 base = default[(default["g0"] == g0) & (default["theta0_deg"] == theta0)]
                 if len(base):
@@ -169,7 +183,7 @@ def main():
         sys.exit("convergence_study: no sweep has finished")
     table = tabulate(frames)
     meta = dict(ensemble=ENSEMBLE, seeds=f"0-{SEEDS - 1}", sweeps=finished,
-                settings={k: " ".join(v) for k, v in SETTINGS.items()},
+                settings={k: " ".join(v) for k, v in SETTINGS.items()}, baselines=BASELINE,
                 intervals="95% Wilson (p), Newcombe hybrid score (p differences), percentile "
                           "bootstrap (quantiles); verdict with Bonferroni intervals",
                 certain=f"95% Wilson lower end >= {dd.CERTAIN_LOWER}",
@@ -181,7 +195,7 @@ def main():
     storage.write_table_atomically(storage.described(arrow, columns.CONVERGENCE_COLUMNS),
                                    args.out)
     with pd.option_context("display.width", 200, "display.max_columns", 30):
-        print(table[["g0", "theta0_deg", "setting", "seeds", "p_3d", "p_steady", "tilt_q50",
+        print(table[["g0", "theta0_deg", "setting", "baseline", "seeds", "p_3d", "p_steady", "tilt_q50",
                      "certain_regime"] + [c for c in ("verdict",) if c in table]].to_string())
     print(f"wrote {args.out}")
 
