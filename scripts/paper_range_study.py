@@ -4,6 +4,7 @@ probabilities").
 Usage: python scripts/paper_range_study.py [--runs runs] [--threads T] [--data data]
                                            [--figure docs/figures/paper_range.png]
                                            [--max-seeds 8] [--quick] [--read-only]
+                                           [--top] [--parts NAME,...]
 
 The paper's Fig. 5 grid is ``--g0 10:350:15 --theta0 6:90:15`` (225 cells).  This study
 runs, with ``--seeds auto --n auto`` (twins, at most --max-seeds seeds, each sampled
@@ -22,8 +23,19 @@ cell checked in distribution against up to 8 seeds at 10x stricter tolerances):
   cell);
 * ``paper_range_mid66``: g0 = 155.7-228.6 at 66° and 72° (8 cells).
 
-The other cells (g0 > 150 and θ0 >= 24°, except those) are not run: one of their samples
-costs minutes (docs/distributions.md gives the measured costs and the projection).
+The other 72 cells (g0 > 150 and θ0 >= 24°, except those) are ``--top``'s parts, each
+sample costing seconds to minutes (docs/distributions.md gives the measured costs):
+
+* ``paper_range_top78``: g0 = 155.7-228.6 at θ0 = 78°, 84° and 90° (12 cells);
+* ``paper_range_top24`` ... ``paper_range_top84``: g0 = 252.9-350 at θ0 = 24° and 30°,
+  36° and 42°, ..., 84° and 90° (10 cells each).
+
+Their sweeps go to ``data/paper_range_runs`` by default, a folder committed as parts
+finish (finished ones whole, the running one as far as it got), so that the study
+resumes on another machine where it stopped; their tables are
+``DATA/paper_range_top_summary.parquet`` and ``DATA/paper_range_top_stops.parquet`` and
+their figure ``docs/figures/paper_range_top.png``.  ``--parts`` runs (or tabulates) only
+the parts named.
 
 Writes ``DATA/paper_range_summary.parquet`` (``loopsim summary`` of every part's rows,
 one row per cell) and ``DATA/paper_range_stops.parquet`` (their stop tables: why each
@@ -64,6 +76,10 @@ PARTS = (("paper_range_low", G0[:6], THETA0), ("paper_range_band", G0[6:], THETA
          ("paper_range_mid42", G0[6:10], THETA0[6:8]),
          ("paper_range_mid54", G0[6:10], THETA0[8:10]),
          ("paper_range_mid66", G0[6:10], THETA0[10:12]))
+#: The 72 cells the parts above leave out (``--top``), the cheapest part first.
+TOP_PARTS = (("paper_range_top78", G0[6:10], THETA0[12:]),
+             *((f"paper_range_top{THETA0[k]:.0f}", G0[10:], THETA0[k:k + 2])
+               for k in range(3, 15, 2)))
 QUICK_PARTS = (("paper_range_low", G0[:2], THETA0[::7]), ("paper_range_band", G0[6:7],
                                                             THETA0[:1]))
 #: Where ``--quick`` writes by default: its sweeps, tables and figure.
@@ -72,8 +88,14 @@ QUICK_RUNS = os.path.join("runs", "paper_range_quick")
 #: the study runs in): ``--quick`` never writes over them.
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SUMMARY_FILE, STOPS_FILE = "paper_range_summary.parquet", "paper_range_stops.parquet"
+TOP_SUMMARY_FILE = "paper_range_top_summary.parquet"
+TOP_STOPS_FILE = "paper_range_top_stops.parquet"
+#: Where ``--top`` keeps its sweeps by default: committed, so that the study resumes.
+TOP_RUNS = os.path.join("data", "paper_range_runs")
 COMMITTED = (os.path.join("data", SUMMARY_FILE), os.path.join("data", STOPS_FILE),
-             os.path.join("docs", "figures", "paper_range.png"))
+             os.path.join("docs", "figures", "paper_range.png"),
+             os.path.join("data", TOP_SUMMARY_FILE), os.path.join("data", TOP_STOPS_FILE),
+             os.path.join("docs", "figures", "paper_range_top.png"))
 
 
 def values(array):
@@ -120,7 +142,30 @@ def parse_args(argv=None):
     parser.add_argument("--quick", action="store_true",
                         help="a few cells, t = 0.5, n <= 8: exercises the script (writes under "
                              f"{QUICK_RUNS} by default, never over the committed study)")
-    return resolve_outputs(parser.parse_args(argv))
+    parser.add_argument("--top", action="store_true",
+                        help="the 72 cells the other parts leave out (sweeps under "
+                             f"{TOP_RUNS} by default, committed as they finish)")
+    parser.add_argument("--parts", default=None,
+                        help="run (or tabulate) only these parts, comma-separated")
+    args = parser.parse_args(argv)
+    if args.top and args.quick:
+        raise ValueError("--top and --quick exclude each other")
+    return resolve_outputs(args)
+
+
+def selected_parts(args):
+    """The parts to run: --quick's, --top's or the study's, those named by --parts only;
+    ValueError (one line) naming an unknown part."""
+    parts = QUICK_PARTS if args.quick else TOP_PARTS if args.top else PARTS
+    if not args.parts:
+        return parts
+    known = {name: part for part in parts for name in [part[0]]}
+    wanted = [name.strip() for name in args.parts.split(",") if name.strip()]
+    unknown = [name for name in wanted if name not in known]
+    if unknown or not wanted:
+        raise ValueError(f"--parts {args.parts!r}: unknown part(s) {', '.join(unknown) or '(none)'}"
+                         f"; the parts here are {', '.join(known)}")
+    return [known[name] for name in wanted]
 
 
 def resolve_outputs(args):
@@ -128,13 +173,17 @@ def resolve_outputs(args):
     study's places, or with ``--quick`` one folder of its own (:data:`QUICK_RUNS`).  A
     ValueError where ``--quick`` would write a table or the figure over one of the
     committed study's (:data:`COMMITTED`, in the repository or the working directory)."""
+    top = getattr(args, "top", False)
     if args.runs is None:
-        args.runs = QUICK_RUNS if args.quick else "runs"
+        args.runs = QUICK_RUNS if args.quick else TOP_RUNS if top else "runs"
     if args.data is None:
         args.data = args.runs if args.quick else "data"
     if args.figure is None:
         args.figure = (os.path.join(args.runs, "paper_range.png") if args.quick
-                       else os.path.join("docs", "figures", "paper_range.png"))
+                       else os.path.join("docs", "figures",
+                                         "paper_range_top.png" if top else "paper_range.png"))
+    args.summary_file, args.stops_file = ((TOP_SUMMARY_FILE, TOP_STOPS_FILE) if top
+                                          else (SUMMARY_FILE, STOPS_FILE))
     if args.quick:
         committed = {os.path.realpath(os.path.join(base, path))
                      for base in (ROOT, os.getcwd()) for path in COMMITTED}
@@ -168,11 +217,12 @@ def steady_lines(table):
 def main():
     try:
         args = parse_args()
+        parts = selected_parts(args)
     except ValueError as exc:
         print(f"paper_range_study: error: {exc}", file=sys.stderr)
         sys.exit(2)
     frames, stops, checks = [], [], []
-    for name, g0, theta0 in QUICK_PARTS if args.quick else PARTS:
+    for name, g0, theta0 in parts:
         path = os.path.join(args.runs, name)
         if not args.read_only:
             run_part(path, g0, theta0, args.threads, args.max_seeds, args.quick)
@@ -196,9 +246,9 @@ def main():
     meta = dict(summary_of=" + ".join(sorted(set(frame["part"]))))
     shown = ["g0", "theta0_deg", "seeds", "determined", "p_stable", "p_in_plane", "p_3d",
              "tilt_median", "tilt_median_low", "tilt_median_high"]
-    print_and_write(table, os.path.join(args.data, SUMMARY_FILE), meta,
+    print_and_write(table, os.path.join(args.data, args.summary_file), meta,
                     shown, declarations=columns.SUMMARY_COLUMNS)
-    print_and_write(stop, os.path.join(args.data, STOPS_FILE), meta,
+    print_and_write(stop, os.path.join(args.data, args.stops_file), meta,
                     ["g0", "theta0_deg", "seeds", "stop_reason", "runs", "check_verdict",
                      "check_tilt_wasserstein"], declarations=columns.STOP_COLUMNS)
     runs_s, check_s = cost(frame, check_rows)

@@ -83,3 +83,32 @@ def test_the_printout_counts_unknown_steady_cells_apart():
     assert lines[0].endswith("1; runs not steady: 1 of 8"), lines
     assert lines[1] == "  (60.0, 30°): 1 of 4"
     assert lines[2].endswith("unknown (run with --no-early-stop: no run tested): 1")
+
+
+def test_the_top_parts_are_the_cells_the_study_left_out():
+    """--top's parts cover the paper's 225-cell grid together with the study's, each cell
+    once: the 72 cells with g0 > 150 and θ0 >= 24° outside g0 = 155.7-228.6 at 24-72°."""
+    names = study()
+    cells = [(round(g, 6), round(t, 6)) for parts in (names["PARTS"], names["TOP_PARTS"])
+             for _, g0, theta0 in parts for g in g0 for t in theta0]
+    top = [(round(g, 6), round(t, 6)) for _, g0, theta0 in names["TOP_PARTS"]
+           for g in g0 for t in theta0]
+    assert len(cells) == len(set(cells)) == 225 and len(top) == 72
+    assert all(g > 150 and t >= 24 and not (g < 230 and t <= 72) for g, t in top)
+
+
+def test_top_keeps_its_sweeps_and_tables_apart(monkeypatch):
+    """--top writes its sweeps under data/paper_range_runs (committed, so that it resumes
+    elsewhere) and tables and figure of its own; --parts picks parts, an unknown one is a
+    one-line error with exit status 2 before any sweep."""
+    monkeypatch.chdir(ROOT)
+    names = study()
+    args = names["parse_args"](["--top", "--parts", "paper_range_top78"])
+    assert (args.runs, args.data) == (os.path.join("data", "paper_range_runs"), "data")
+    assert args.summary_file == "paper_range_top_summary.parquet"
+    assert args.figure == os.path.join("docs", "figures", "paper_range_top.png")
+    assert [p[0] for p in names["selected_parts"](args)] == ["paper_range_top78"]
+    done = subprocess.run([sys.executable, SCRIPT, "--top", "--parts", "paper_range_low"],
+                          capture_output=True, text=True, timeout=300, cwd=ROOT)
+    err = done.stderr.strip().splitlines()
+    assert done.returncode == 2 and len(err) == 1 and "paper_range_low" in err[0], done.stderr
