@@ -225,9 +225,8 @@ def _difference_columns(stat, unit, what):
 
 #: name: (unit, description) of every column of the convergence table
 #: (``scripts/convergence_study.py``, ``data/convergence_top.parquet``): one row per cell
-#: and setting; the ``delta_*`` columns compare the setting with its baseline, the
-#: defaults on the same code (``loopsim.distribution_differences``; empty on the
-#: default's own rows).
+#: and setting; the ``delta_*`` columns compare the setting with its baseline (column
+#: ``baseline``; ``loopsim.distribution_differences``; empty on the default's own rows).
 CONVERGENCE_COLUMNS = {
     "g0": RESULT_COLUMNS["g0"],
     "theta0_deg": RESULT_COLUMNS["theta0_deg"],
@@ -235,9 +234,10 @@ CONVERGENCE_COLUMNS = {
     "setting": (TEXT, "default, rtol1e-8, n40, amp1e-4, jmid, jmid_rtol1e-8 or jmid_n40 "
                       "(the sweep options: the table's metadata, loopsim_convergence; the "
                       "code: STUDY_COMMITS.json)"),
-    "baseline": (TEXT, "the setting the delta_* columns compare this one with: the "
-                       "defaults on the same code (default, or jmid for jmid_*); empty on "
-                       "the default's rows"),
+    "baseline": (TEXT, "the setting the delta_* columns compare this one with: default, "
+                       "or jmid (the defaults on the same code) for jmid_rtol1e-8 and "
+                       "jmid_n40; jmid itself is compared with default across two codes "
+                       "(STUDY_COMMITS.json); empty where no comparison was made"),
     "seeds": (COUNT, "seeds of the cell at this setting"),
     "failed": (COUNT, "of them, runs that failed"),
     **{f"p_{name}{end}": (PROBABILITY, f"share of the seeds {what}" + (

@@ -128,12 +128,14 @@ def parse_args(argv=None):
     ValueError (one line) where ``--quick`` would write over the committed study."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", default=None,
-                        help=f"the sweeps' folder (default: runs; with --quick {QUICK_RUNS})")
+                        help=f"the sweeps' folder (default: runs; with --quick {QUICK_RUNS}; "
+                             f"with --top {TOP_RUNS})")
     parser.add_argument("--data", default=None,
                         help="the tables' folder (default: data; with --quick --runs)")
     parser.add_argument("--figure", default=None,
                         help="the figure (default: docs/figures/paper_range.png; with --quick "
-                             "RUNS/paper_range.png; empty: none)")
+                             "RUNS/paper_range.png; with --top docs/figures/paper_range_top.png; "
+                             "empty: none)")
     parser.add_argument("--threads", type=int, default=os.cpu_count() or 1)
     parser.add_argument("--max-seeds", type=int, default=8)
     parser.add_argument("--read-only", action="store_true",
@@ -146,7 +148,8 @@ def parse_args(argv=None):
                         help="the 72 cells the other parts leave out (sweeps under "
                              f"{TOP_RUNS} by default, committed as they finish)")
     parser.add_argument("--parts", default=None,
-                        help="run (or tabulate) only these parts, comma-separated")
+                        help="run only these parts, comma-separated (the tables cover every "
+                             "finished part)")
     args = parser.parse_args(argv)
     if args.top and args.quick:
         raise ValueError("--top and --quick exclude each other")
@@ -154,18 +157,19 @@ def parse_args(argv=None):
 
 
 def selected_parts(args):
-    """The parts to run: --quick's, --top's or the study's, those named by --parts only;
-    ValueError (one line) naming an unknown part."""
+    """(the parts tabulated, the names of those to run): --quick's, --top's or the
+    study's parts, all tabulated where finished; those named by --parts run (all without
+    it); ValueError (one line) naming an unknown part."""
     parts = QUICK_PARTS if args.quick else TOP_PARTS if args.top else PARTS
     if not args.parts:
-        return parts
-    known = {name: part for part in parts for name in [part[0]]}
+        return parts, {part[0] for part in parts}
+    known = [part[0] for part in parts]
     wanted = [name.strip() for name in args.parts.split(",") if name.strip()]
-    unknown = [name for name in wanted if name not in known]
+    unknown = ", ".join(name for name in wanted if name not in known)
     if unknown or not wanted:
-        raise ValueError(f"--parts {args.parts!r}: unknown part(s) {', '.join(unknown) or '(none)'}"
-                         f"; the parts here are {', '.join(known)}")
-    return [known[name] for name in wanted]
+        raise ValueError(f"--parts {args.parts!r}: " + (f"unknown part(s) {unknown}" if unknown
+                         else "names no part") + f"; the parts here are {', '.join(known)}")
+    return parts, set(wanted)
 
 
 def resolve_outputs(args):
@@ -217,16 +221,16 @@ def steady_lines(table):
 def main():
     try:
         args = parse_args()
-        parts = selected_parts(args)
+        parts, to_run = selected_parts(args)
     except ValueError as exc:
         print(f"paper_range_study: error: {exc}", file=sys.stderr)
         sys.exit(2)
     frames, stops, checks = [], [], []
     for name, g0, theta0 in parts:
         path = os.path.join(args.runs, name)
-        if not args.read_only:
+        if not args.read_only and name in to_run:
             run_part(path, g0, theta0, args.threads, args.max_seeds, args.quick)
-        elif not os.path.isfile(os.path.join(path, storage.STOPS_FILE)):
+        if not os.path.isfile(os.path.join(path, storage.STOPS_FILE)):
             print(f"{name}: not finished, left out ({len(g0) * len(theta0)} cells)")
             continue
         frames.append(storage.read_seeds_auto(path).assign(part=name))
@@ -251,6 +255,16 @@ def main():
     print_and_write(stop, os.path.join(args.data, args.stops_file), meta,
                     ["g0", "theta0_deg", "seeds", "stop_reason", "runs", "check_verdict",
                      "check_tilt_wasserstein"], declarations=columns.STOP_COLUMNS)
+    print_findings(table, frame.drop(columns="part"), check_rows)
+    if args.figure:
+        use_agg()
+        save_distribution_figure(table, frame.drop(columns="part"), args.figure, dpi=FIGURE_DPI)
+        print(f"figure: {args.figure}")
+
+
+def print_findings(table, frame, check_rows):
+    """The printout: the cost, the certain and mixed cells, where seed 0 misleads, and
+    the cells with seeds still moving at t_end."""
     runs_s, check_s = cost(frame, check_rows)
     print(f"\ncost: {len(frame)} runs {runs_s:.0f} s with their twins, {len(check_rows)} "
           f"check runs {check_s:.0f} s; {(runs_s + check_s) / 3600:.2f} h of one core")
@@ -275,10 +289,6 @@ def main():
     print("by regime of the most probable outcome (a/b: a tie): "
           + ", ".join(f"{k} {v}" for k, v in likeliest.value_counts().items()))
     print("\n".join(steady_lines(table)))
-    if args.figure:
-        use_agg()
-        save_distribution_figure(table, frame.drop(columns="part"), args.figure, dpi=FIGURE_DPI)
-        print(f"figure: {args.figure}")
 
 
 if __name__ == "__main__":

@@ -99,15 +99,18 @@ def test_the_top_parts_are_the_cells_the_study_left_out():
 
 def test_top_keeps_its_sweeps_and_tables_apart(monkeypatch):
     """--top writes its sweeps under data/paper_range_runs (committed, so that it resumes
-    elsewhere) and tables and figure of its own; --parts picks parts, an unknown one is a
-    one-line error with exit status 2 before any sweep."""
+    elsewhere) and tables and figure of its own; --parts picks the parts to run (the tables
+    still cover every finished part, so a partial run never shrinks them), an unknown one
+    is a one-line error with exit status 2 before any sweep."""
     monkeypatch.chdir(ROOT)
     names = study()
     args = names["parse_args"](["--top", "--parts", "paper_range_top78"])
     assert (args.runs, args.data) == (os.path.join("data", "paper_range_runs"), "data")
     assert args.summary_file == "paper_range_top_summary.parquet"
     assert args.figure == os.path.join("docs", "figures", "paper_range_top.png")
-    assert [p[0] for p in names["selected_parts"](args)] == ["paper_range_top78"]
+    parts, to_run = names["selected_parts"](args)
+    assert to_run == {"paper_range_top78"}  # runs one part; tabulates every finished one
+    assert [p[0] for p in parts] == [p[0] for p in names["TOP_PARTS"]]
     done = subprocess.run([sys.executable, SCRIPT, "--top", "--parts", "paper_range_low"],
                           capture_output=True, text=True, timeout=300, cwd=ROOT)
     err = done.stderr.strip().splitlines()
