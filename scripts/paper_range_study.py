@@ -34,8 +34,8 @@ Their sweeps go to ``data/paper_range_runs`` by default, a folder committed as p
 finish (finished ones whole, the running one as far as it got), so that the study
 resumes on another machine where it stopped; their tables are
 ``DATA/paper_range_top_summary.parquet`` and ``DATA/paper_range_top_stops.parquet`` and
-their figure ``docs/figures/paper_range_top.png``.  ``--parts`` runs (or tabulates) only
-the parts named.
+their figure ``docs/figures/paper_range_top.png``.  ``--parts`` runs only the parts named;
+the tables and the figure cover every finished part.
 
 Writes ``DATA/paper_range_summary.parquet`` (``loopsim summary`` of every part's rows,
 one row per cell) and ``DATA/paper_range_stops.parquet`` (their stop tables: why each
