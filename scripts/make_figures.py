@@ -61,7 +61,11 @@ The figure suite's own runs (all but ``main_job`` and ``seed_cells``) skip the t
 (``--no-twin``): these figures draw no determinacy, and the twin would cost 1.5-2.5x.
 work_precision (docs/performance.md) runs ``benchmarks/bench_trajectory.py`` itself
 (``WORK_PRECISION``: about 15 minutes on one core); paper_range (docs/distributions.md)
-runs ``scripts/paper_range_study.py``, which also writes its tables into data/.  Fig. 3 and nonlocal_thresholds (the circle's critical q against ε) need no run.  Nothing
+runs ``scripts/paper_range_study.py``, which also writes its tables into data/;
+paper_range_top redraws the top of that range from the sweeps committed under
+data/paper_range_runs (``paper_range_study.py --top --read-only``: the parts themselves
+take hours each and run apart, see docs/distributions.md).  Fig. 3 and
+nonlocal_thresholds (the circle's critical q against ε) need no run.  Nothing
 here is random beyond the seeded initial perturbations
 (seed 0 unless stated), so a rerun reproduces the tables.
 
@@ -250,6 +254,7 @@ def targets(quick=False):
         "report_main_job": (["main_job"], ("report", "main_job")),
         "work_precision": ([], ("benchmark",)),
         "paper_range": ([], ("study",)),
+        "paper_range_top": ([], ("study_top",)),
         "seed_distributions": (["seeds_n6", "seeds_auto"],
                                ("figures", "seeds_n6", ["seeds_n6", "seeds_auto"], "seeds",
                                 "seed_distributions")),
@@ -332,13 +337,16 @@ def draw(name, how, paths, out, work, quick):
         os.makedirs(work, exist_ok=True)
         os.makedirs(out, exist_ok=True)
         subprocess.run(command, check=True, env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
-    elif kind == "study":
+    elif kind in ("study", "study_top"):
         runs = os.path.dirname(os.path.dirname(work))  # --runs (work is RUNS/fig/draw)
-        command = [sys.executable, os.path.join(os.path.dirname(__file__),
-                                                "paper_range_study.py"),
-                   "--runs", runs, "--figure", target,
-                   "--data", os.path.join(work, "data") if quick else "data",
-                   *(["--quick"] if quick else [])]
+        script = os.path.join(os.path.dirname(__file__), "paper_range_study.py")
+        data = os.path.join(work, "data") if quick else "data"
+        if kind == "study":
+            command = [sys.executable, script, "--runs", runs, "--figure", target,
+                       "--data", data, *(["--quick"] if quick else [])]
+        else:  # the committed parts, redrawn
+            command = [sys.executable, script, "--top", "--read-only", "--figure", target,
+                       "--data", data]
         print("$ " + " ".join(shlex.quote(a) for a in command), flush=True)
         os.makedirs(out, exist_ok=True)
         subprocess.run(command, check=True)
