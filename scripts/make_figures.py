@@ -338,10 +338,10 @@ def draw(name, how, paths, out, work, quick):
         os.makedirs(out, exist_ok=True)
         subprocess.run(command, check=True, env=dict(os.environ, OPENBLAS_NUM_THREADS="1"))
     elif kind in ("study", "study_top"):
-        runs = os.path.dirname(os.path.dirname(work))  # --runs (work is RUNS/fig/draw)
         script = os.path.join(os.path.dirname(__file__), "paper_range_study.py")
         data = os.path.join(work, "data") if quick else "data"
         if kind == "study":
+            runs = os.path.dirname(os.path.dirname(work))  # --runs (work is RUNS/fig/draw)
             command = [sys.executable, script, "--runs", runs, "--figure", target,
                        "--data", data, *(["--quick"] if quick else [])]
         else:  # the committed parts, redrawn

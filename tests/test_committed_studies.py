@@ -15,7 +15,6 @@ def script(name, *args):
     done = subprocess.run([sys.executable, os.path.join("scripts", name), *args], cwd=ROOT,
                           capture_output=True, text=True, timeout=300)
     assert done.returncode == 0, done.stdout[-2000:] + done.stderr[-2000:]
-    return done.stdout
 
 
 def committed(name):
