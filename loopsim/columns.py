@@ -231,13 +231,14 @@ CONVERGENCE_COLUMNS = {
     "g0": RESULT_COLUMNS["g0"],
     "theta0_deg": RESULT_COLUMNS["theta0_deg"],
     "q0": RESULT_COLUMNS["q0"],
-    "setting": (TEXT, "default, rtol1e-8, n40, amp1e-4, jmid, jmid_rtol1e-8 or jmid_n40 "
+    "setting": (TEXT, "default, rtol1e-8, n40, amp1e-4, jmid, jmid_rtol1e-8, jmid_n40 or "
+                      "jmid_rtol1e-3 "
                       "(the sweep options: the table's metadata, loopsim_convergence; the "
                       "code: STUDY_COMMITS.json)"),
     "baseline": (TEXT, "the setting the delta_* columns compare this one with: default, "
-                       "or jmid (the defaults on the same code) for jmid_rtol1e-8 and "
-                       "jmid_n40; jmid itself is compared with default across two codes "
-                       "(STUDY_COMMITS.json); empty where no comparison was made"),
+                       "or jmid (the defaults on the same code) for jmid_rtol1e-8, "
+                       "jmid_n40 and jmid_rtol1e-3; jmid itself is compared with default "
+                       "across two codes (STUDY_COMMITS.json); empty where no comparison was made"),
     "seeds": (COUNT, "seeds of the cell at this setting"),
     "failed": (COUNT, "of them, runs that failed"),
     **{f"p_{name}{end}": (PROBABILITY, f"share of the seeds {what}" + (
