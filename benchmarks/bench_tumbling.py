@@ -70,10 +70,11 @@ def problem_of(n):
                                  local_sbt.make_workspace(n))
 
 
-def radau(problem, y0, t0, t1, rtol, point):
-    """radau5 with ``jacobian_point`` = point from y0 at t0 to t1, atol = rtol / 1000:
-    (wall s, status, end state, counts [steps, rejected, nfev, njev, nlu])."""
-    method = integrators.RADAU5._replace(jacobian_point=point)
+def radau(problem, y0, t0, t1, rtol, point, **fields):
+    """radau5 with ``jacobian_point`` = point (and any other ``RadauIIA`` fields changed)
+    from y0 at t0 to t1, atol = rtol / 1000: (wall s, status, end state, counts [steps,
+    rejected, nfev, njev, nlu])."""
+    method = integrators.RADAU5._replace(jacobian_point=point, **fields)
     options = integrators.step_options(rtol, rtol * 1e-3)
     start = time.perf_counter()
     status, _, y, counts, _ = driver.integrate(method, problem, y0.copy(), t0, t1, None,
