@@ -41,11 +41,13 @@ def sample_costs(frame, units_by_n):
 
 def unit_costs_by_order(orders, given=None):
     """{n: unit costs (s)}: measured at each n, or ``given`` ("F,J,LU_PAIR" in ms) at all."""
+    fixed = None
+    if given:
+        fixed = dict(zip(("f", "j", "lu_pair"), (float(v) * 1e-3 for v in given.split(","))))
     units_by_n = {}
     for n in orders:
-        if given:
-            f, j, lu_pair = (float(v) * 1e-3 for v in given.split(","))
-            units_by_n[n] = dict(f=f, j=j, lu_pair=lu_pair)
+        if fixed:
+            units_by_n[n] = fixed
         else:
             x0 = loading.start_shape(bench_tumbling.THETA0, n, None, bench_tumbling.SEED)[0]
             units_by_n[n] = bench_tumbling.unit_costs(bench_tumbling.problem_of(n), x0.ravel())
@@ -92,7 +94,7 @@ def main():
     table = pd.DataFrame(rows).set_index("sweep")
     base = table.iloc[0]
     for column in ("priced_s", "wall_s", "tumbling_priced_median_s"):
-        table[column.replace("_s", "_ratio")] = table[column] / base[column]
+        table[column.removesuffix("_s") + "_ratio"] = table[column] / base[column]
     print(f"# (g0, θ0) = ({args.g0:g}, 18°); load average {os.getloadavg()[0]:.1f} on "
           f"{os.cpu_count()} cores")
     with pd.option_context("display.width", 200, "display.max_columns", 20):
