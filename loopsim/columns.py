@@ -158,6 +158,37 @@ SUMMARY_COLUMNS = {
                                          "interval"),
                           ("median_high", "upper end of the median's 95% percentile-bootstrap "
                                           "interval"))},
+    # settling (loopsim.survival): a run comes to rest at t_final when it stops early
+    # (stop_reason steady) and is censored at t_end otherwise; failures left out
+    "rest_observed": (COUNT, "rows of the cell with a settling or censoring time (failures "
+                             "left out)"),
+    "at_rest": (COUNT, "rows of the cell that came to rest (passed the steady test) before "
+                       "t_end"),
+    **{f"p_rest_t10{end}": (PROBABILITY, what) for end, what in (
+        ("", "P(at rest by the paper's horizon t = 10 t_u), Kaplan-Meier (a plain share "
+             "where no run stopped before t = 10 without coming to rest)"),
+        ("_low", "lower end of its 95% interval (Wilson, or the Kaplan-Meier log-log band)"),
+        ("_high", "upper end of its 95% interval"))},
+    "t_rest_median": (TIME, "median settling time, Kaplan-Meier (NaN: fewer than half came "
+                            "to rest within the runs' t_end)"),
+    "t_rest_median_low": (TIME, "lower end of its 95% interval (where the log-log band's "
+                                "lower limit crosses 1/2)"),
+    "t_rest_median_high": (TIME, "upper end of its 95% interval (where the band's upper "
+                                 "limit crosses 1/2; NaN: beyond the runs' t_end)"),
+    "t_rest_q95": (TIME, "time by which 95% of the cell's runs come to rest, Kaplan-Meier "
+                         "(NaN: not reached within the runs' t_end)"),
+    "escape_events": (COUNT, "runs that came to rest after t = 10 (the tail)"),
+    "tail_time": (TIME, "time observed after t = 10, summed over the cell's runs"),
+    "escape_rate": ("1/t_u", "rate at which loops still moving after t = 10 come to rest, "
+                             "escape_events / tail_time (NaN: fewer than 3 events)"),
+    "escape_rate_low": ("1/t_u", "lower end of its exact 95% Poisson interval"),
+    "escape_rate_high": ("1/t_u", "upper end of its exact 95% Poisson interval"),
+    **{f"rest_{where}": (COUNT, f"rows that came to rest {what} (loopsim.stability."
+                                "rest_window; only where a summary is asked for them)")
+       for where, what in (("inside", "inside the stable branch's tilt window at their g0"),
+                           ("below", "below the window: a tilted circle (q < 8.9001)"),
+                           ("outside", "above the window, where no steady shape is stable "
+                                       "(expected none)"))},
     "nfev": (COUNT, "right-hand-side evaluations of the cell's runs, summed"),
     "twin_nfev": (COUNT, "right-hand-side evaluations of the cell's twins, summed"),
     "wall_s": ("s", "wall time of the cell's runs, summed (compilation and twins left out)"),

@@ -27,6 +27,7 @@ Plain NumPy and pandas: no integration happens here.
 import numpy as np
 import pandas as pd
 
+from . import survival
 from .outcomes import REGIMES
 
 #: z of a two-sided 95 % interval, Φ⁻¹(0.975).
@@ -108,7 +109,7 @@ def steady_tested(frame):
     return not (isinstance(config, dict) and config.get("early_stop") is False)
 
 
-def _cell_row(rows, seed, tested=True):
+def _cell_row(rows, seed, tested=True, window=None):
     trials = len(rows)
     out = dict(seeds=trials, resolved=int(rows["resolved"].sum()),
                determined=int(rows["determined"].eq(True).sum()))
@@ -133,12 +134,16 @@ def _cell_row(rows, seed, tested=True):
         out[f"{short}_q25"], out[f"{short}_median"], out[f"{short}_q75"] = map(float, quartiles)
         out[f"{short}_median_low"], out[f"{short}_median_high"] = bootstrap_interval(
             finite, seed=seed)
+    if tested and "stop_reason" in rows and "t_final" in rows:
+        out.update(survival.settling_statistics(rows))
+        if window is not None:
+            out.update(survival.window_counts(rows, window))
     for column in ("nfev", "twin_nfev", "wall_s"):
         out[column] = rows[column].sum() if column in rows else 0
     return out
 
 
-def summarize(frame, by=None, seed=0):
+def summarize(frame, by=None, seed=0, rest_window=None):
     """Outcomes as distributions: one row per cell of a results table, from its seeds.
 
     A cell is one point of the sweep's inputs with the seed left out: ``g0``,
@@ -157,6 +162,10 @@ def summarize(frame, by=None, seed=0):
         every other input that varies).
     seed : int, default 0
         Seed of the bootstrap's generator (the table is reproducible bit for bit).
+    rest_window : loopsim.stability.rest_window.RestWindow or None, default None
+        Where loops can rest (``loopsim.stability.rest_window.stability_losses``): with
+        it, the rows that came to rest are counted inside, below and outside the tilt
+        window at their g0 (``rest_inside``, ``rest_below``, ``rest_outside``).
 
     Returns
     -------
@@ -179,6 +188,11 @@ def summarize(frame, by=None, seed=0):
         * the quartiles of the terminal tilt (degrees), aspect ratio and q
           (``tilt_*``, ``aspect_*``, ``q_final_*``), each median with a 95 %
           percentile-bootstrap interval (``BOOTSTRAP_RESAMPLES`` resamples);
+        * the settling statistics (``loopsim.survival``, where the rows were tested for
+          a steady state): ``rest_observed``, ``at_rest``, P(at rest by t = 10)
+          ``p_rest_t10`` with its interval, the Kaplan–Meier median settling time
+          ``t_rest_median`` with its interval, ``t_rest_q95``, and the escape rate after
+          t = 10 (``escape_rate``, its interval, ``escape_events``, ``tail_time``);
         * the cost: ``nfev``, ``twin_nfev`` and ``wall_s`` (seconds) summed.
 
         ``table.attrs["loopsim_summary"]`` records the cell columns and the bootstrap.
@@ -206,7 +220,7 @@ def summarize(frame, by=None, seed=0):
     if not len(frame):
         raise ValueError("no rows to summarise")
     tested = steady_tested(frame)
-    rows = [dict(zip(by, key), **_cell_row(group, seed, tested))
+    rows = [dict(zip(by, key), **_cell_row(group, seed, tested, rest_window))
             for key, group in cell_groups(frame, by)]
     table = pd.DataFrame(rows)
     if "steady" in table and not tested:

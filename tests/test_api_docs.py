@@ -118,6 +118,9 @@ def test_every_public_name_is_in_the_api_reference():
 #: Docstrings whose examples are not run, and why: each takes longer than 2 s.
 SKIPPED_EXAMPLES = {
     "loopsim.figures.animation.animate": "draws and encodes a GIF's frames: 8-10 s",
+    "loopsim.stability.rest_window.rest_window": "continues the branch to its fold at n = 16: "
+                                                 "20 s of one core; its values are checked "
+                                                 "in tests/test_rest_window.py",
 }
 
 

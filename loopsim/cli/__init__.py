@@ -8,7 +8,7 @@ limit) exits 3
 scripts/cli_reference.py).
 
 One module per command (``run``, ``sweep``, ``stability``, ``summary``, ``compare``,
-``branch``, ``figures``, ``report``, ``animate``), each with its ``add_parser`` (its
+``branch``, ``rest-window``, ``figures``, ``report``, ``animate``), each with its ``add_parser`` (its
 options) and ``command`` (its work); ``common`` holds what they share.  Modules load
 nothing heavy until a command runs: ``loopsim --help`` imports neither NumPy nor Numba.
 """
@@ -20,15 +20,16 @@ import warnings
 
 from .._version import __version__
 from ..exit_codes import ENVIRONMENT_ERRNOS
-from . import animate, branch, compare, figures, report, run, stability, summary, sweep
+from . import (animate, branch, compare, figures, report, rest_window, run, stability, summary,
+               sweep)
 from .common import EXIT_ENVIRONMENT, EXIT_EPILOG, EXIT_FAILED_RUN, EXIT_USAGE, METHODS, Parser
 
 __all__ = ["EXIT_ENVIRONMENT", "EXIT_FAILED_RUN", "EXIT_USAGE", "METHODS", "build_parser", "main"]
 
 #: The commands, in the order ``loopsim --help`` lists them.
 COMMANDS = {"run": run, "sweep": sweep, "stability": stability, "summary": summary,
-            "compare": compare, "branch": branch, "figures": figures, "report": report,
-            "animate": animate}
+            "compare": compare, "branch": branch, "rest-window": rest_window,
+            "figures": figures, "report": report, "animate": animate}
 
 
 #: ``loopsim --help``'s examples: the README's main job first (tests/test_cli_reference.py).

@@ -59,7 +59,7 @@ __all__ = [
     "planar_state", "tilt_shape", "to_plane", "mirror_symmetric_index",
     "neutral_modes", "stability", "Branch", "continue_branch", "steady_branch",
     "q_loss_out_of_plane", "branch_rows", "branch_summary", "ROW_FIELDS", "upper_half", "steady_branch_to",
-    "out_of_plane_loss_near",
+    "out_of_plane_loss_near", "rate_crossing",
 ]
 
 #: First corrector's distance from the circle along φ (L² amplitude), and the
@@ -206,11 +206,14 @@ def _branch_tangent(shape, free, metric, previous):
     return t if np.sum(metric * t * previous) >= 0 else -t
 
 
-def continue_branch(n, q_max, w=DEFAULT_W, side=1, q_min=0.0, max_points=400, step_max=None):
+def continue_branch(n, q_max, w=DEFAULT_W, side=1, q_min=0.0, max_points=400, step_max=None,
+                    stop_after_fold=False):
     """Pseudo-arclength continuation of the steady shapes from the circle at q_c (module
-    docstring), on one side of the circle, until q leaves [q_min, q_max].  Steps (in the
-    norm of (x, q)) grow up to ``step_max`` (default STEP_MAX) while Newton needs ≤ 3
-    iterations, and halve when it fails or a guard rejects the point."""
+    docstring), on one side of the circle, until q leaves [q_min, q_max] (or, with
+    ``stop_after_fold``, two points after q first turns back: the fold then lies
+    between the last three points).  Steps (in the norm of (x, q)) grow up to
+    ``step_max`` (default STEP_MAX) while Newton needs ≤ 3 iterations, and halve when it
+    fails or a guard rejects the point."""
     step_max = STEP_MAX if step_max is None else float(step_max)
     n = validation.check_integer("n", n, 4)
     q_max = validation.check_real("q_max", q_max)
@@ -263,6 +266,8 @@ def continue_branch(n, q_max, w=DEFAULT_W, side=1, q_min=0.0, max_points=400, st
         shapes.append(shape)
         ys.append(y_new)
         tangent = new_tangent
+        if stop_after_fold and len(shapes) > 3 and shapes[-1].q < shapes[-2].q < shapes[-3].q:
+            break
         if out[3] <= 3:
             step = min(step_max, 1.5 * step)
     return Branch(n=n, w=float(w), q_bifurcation=float(q_bif), q_circle=float(qc),
@@ -306,15 +311,16 @@ def branch_rows(n, q_max, w=DEFAULT_W, q_min=None):
     return rows, (up, down)
 
 
-def _crossing(guess, q_lo, q_hi, tol):
-    """brentq on the leading out-of-plane Re σ of the steady shapes at q in [q_lo, q_hi]
-    (Newton in the mirror-symmetric subspace from the last shape solved)."""
+def rate_crossing(guess, q_lo, q_hi, tol, sector="out_of_plane"):
+    """brentq on the leading Re σ of ``sector`` (out_of_plane or in_plane) of the steady
+    shapes at q in [q_lo, q_hi] (Newton in the mirror-symmetric subspace from the last
+    shape solved)."""
     state = {"x": guess.x, "w": guess.w}
 
     def rate(q):
         shape = solve_steady(state["x"], q, state["w"], symmetric=True)
         state["x"] = shape.x
-        return stability(shape)["leading_out_of_plane"].real
+        return stability(shape)[f"leading_{sector}"].real
 
     return float(brentq(rate, q_lo, q_hi, xtol=tol, rtol=4 * np.finfo(float).eps))
 
@@ -329,7 +335,7 @@ def q_loss_out_of_plane(rows, shapes, tol=1e-10):
         if not (a["stable_in_plane"] or i == 1):
             continue
         if a["leading_out_of_plane_real"] < 0.0 <= b["leading_out_of_plane_real"]:
-            return _crossing(shapes[i], a["q"], b["q"], tol)
+            return rate_crossing(shapes[i], a["q"], b["q"], tol)
     return None
 
 
@@ -338,15 +344,17 @@ def out_of_plane_loss_near(shape, n, q_lo, q_hi, tol=1e-10):
     near it (``spectral.resize``; a bracket [q_lo, q_hi] of the crossing at n): a quick
     way through a convergence study in n without continuing from the circle each time."""
     guess = solve_steady(spectral.resize(shape.x, n), shape.q, shape.w, symmetric=True)
-    return _crossing(guess, q_lo, q_hi, tol)
+    return rate_crossing(guess, q_lo, q_hi, tol)
 
 
-def upper_half(n, q_max, w=DEFAULT_W, step_max=None):
-    """The half of the branch that leaves the circle towards q > q_c (in-plane stable)."""
+def upper_half(n, q_max, w=DEFAULT_W, step_max=None, stop_after_fold=False):
+    """The half of the branch that leaves the circle towards q > q_c (in-plane stable),
+    found by a three-point probe of each side, then continued (``continue_branch``)."""
     for side in (-1, 1):
-        half = continue_branch(n, q_max, w, side=side, step_max=step_max)
-        if len(half.shapes) > 2 and half.shapes[2].q > half.shapes[0].q:
-            return half
+        probe = continue_branch(n, q_max, w, side=side, max_points=3, step_max=step_max)
+        if len(probe.shapes) > 2 and probe.shapes[2].q > probe.shapes[0].q:
+            return continue_branch(n, q_max, w, side=side, step_max=step_max,
+                                   stop_after_fold=stop_after_fold)
     raise ValueError(f"no half of the branch leaves towards q > q_c at n = {n}")
 
 

@@ -1,0 +1,197 @@
+"""Where a loop can come to rest: the stable part of the steady branch, as a window of tilts.
+
+A settled loop lies in a plane (docs/stability.md §5): it is either the translating
+circle, stable for q < q_c = 8.9001 (the circle's in-plane threshold, where the branch
+of steady in-plane shapes leaves it), or a steady shape of the branch's in-plane-stable
+half, stable up to the first q where one of its sectors loses stability.  Along that
+half (``branch.upper_half``, continued up to its fold) each loss is located by brentq
+on the leading Re σ of its sector (``branch.rate_crossing``) and typed by the leading
+eigenvalue there: a Hopf bifurcation when it is a complex pair (its frequency Im σ, in
+1/t_u, is the period of the oscillation that grows), a steady bifurcation when it is
+real; the fold is where q turns back along the branch (the largest q of a quadratic
+through the three points around it, in arclength).
+
+Both the branch and its spectra depend on q alone (the loop's plane at tilt θ feels
+the in-plane gravity g0 sin θ = 3q), so at a given g0 the loop rests on the branch
+only where
+
+    q_c ≤ g0 sin θ / 3 ≤ q_loss      ⇔      arcsin(3 q_c / g0) ≤ θ ≤ arcsin(min(1, 3 q_loss / g0))
+
+and as a tilted circle at θ < arcsin(3 q_c / g0) (any tilt if 3 q_c ≥ g0).  Tilts in
+degrees, q and g0 dimensionless.  The local model only: the nonlocal model's branch is
+not continued (``loopsim.stability.branch`` uses the local right-hand side).
+"""
+from __future__ import annotations
+
+import dataclasses
+import functools
+import math
+
+import numpy as np
+
+from .. import validation
+from ..defaults import DEFAULT_W
+from . import branch
+
+__all__ = ["StabilityLoss", "RestWindow", "stability_losses", "rest_window", "tilt_window",
+           "classify_rest", "DEFAULT_WINDOW_N", "REST_CLASSES"]
+
+#: Truncation order of the window: q_loss_out_of_plane within 4e-7 of n = 24
+#: (docs/stability.md §5).
+DEFAULT_WINDOW_N = 16
+#: Continuation step limit (in the norm of (x, q)) along the branch up to its fold.
+WINDOW_STEP_MAX = 0.4
+#: A leading eigenvalue at a crossing is a complex pair (Hopf) when |Im σ| exceeds this.
+HOPF_IM_TOL = 1e-6
+#: Where a settled loop lies relative to the window (``classify_rest``).
+REST_CLASSES = ("inside", "below", "outside")
+
+
+@dataclasses.dataclass(frozen=True)
+class StabilityLoss:
+    """One loss of stability along the branch: ``q``; ``kind`` hopf | steady | fold;
+    ``sector`` out-of-plane | in-plane (None for the fold); ``frequency`` |Im σ| of the
+    leading eigenvalue at the crossing, 1/t_u (0 for a steady bifurcation, NaN for the
+    fold)."""
+
+    q: float
+    kind: str
+    sector: str | None
+    frequency: float
+
+
+@dataclasses.dataclass(frozen=True)
+class RestWindow:
+    """The stable stretch of the branch in q: from ``q_circle`` (the circle's in-plane
+    threshold, where the branch starts) to ``q_loss`` (the first of ``losses``), at
+    truncation ``n`` and penalty ``w``.  :meth:`tilts` turns it into tilts at a g0."""
+
+    n: int
+    w: float
+    q_circle: float
+    losses: tuple
+
+    @property
+    def q_loss(self):
+        """q of the first loss of stability along the branch."""
+        return self.losses[0].q
+
+    def tilts(self, g0):
+        """(θ_low, θ_high) in degrees at ``g0``: the branch's stable tilts (module
+        docstring).  θ_low is NaN where no tilt reaches q_c (3 q_c ≥ g0: every rest is
+        a circle); θ_high is 90 where even θ = 90° stays below the first loss."""
+        return tilt_window(g0, self.q_circle, self.q_loss)
+
+    #: Where a settled loop lies relative to the window (:meth:`classify`).
+    CLASSES = REST_CLASSES
+
+    def classify(self, theta_deg, g0):
+        """``classify_rest(theta_deg, g0, self)``: inside, below or outside the window."""
+        return classify_rest(theta_deg, g0, self)
+
+    def as_dict(self, g0=()):
+        """JSON-ready (NaN as None): n, w, q_circle, q_loss, losses, and per g0 its tilt
+        window."""
+        def clean(record):
+            return {k: None if isinstance(v, float) and math.isnan(v) else v
+                    for k, v in record.items()}
+
+        out = dict(n=self.n, w=self.w, q_circle=self.q_circle, q_loss=self.q_loss,
+                   losses=[clean(dataclasses.asdict(loss)) for loss in self.losses])
+        out["windows"] = [clean(dict(zip(("g0", "theta_low_deg", "theta_high_deg"),
+                                         (float(g), *self.tilts(g))))) for g in g0]
+        return out
+
+
+def tilt_window(g0, q_low, q_high):
+    """(θ_low, θ_high) in degrees of q_low ≤ g0 sin θ / 3 ≤ q_high at ``g0``: θ_low NaN
+    where 3 q_low ≥ g0, θ_high 90 where 3 q_high ≥ g0."""
+    g0 = validation.check_real("g0", g0, 0.0, low_open=True)
+    low = math.degrees(math.asin(3.0 * q_low / g0)) if 3.0 * q_low < g0 else math.nan
+    high = math.degrees(math.asin(min(1.0, 3.0 * q_high / g0)))
+    return low, high
+
+
+def classify_rest(theta_deg, g0, window):
+    """Where a loop settled at tilt ``theta_deg`` (degrees) lies at ``g0``: ``inside`` the
+    window (on the stable branch), ``below`` it (q < q_c: a tilted circle; every tilt is
+    below where 3 q_c ≥ g0) or ``outside`` (above it, where no steady shape is stable);
+    None for a NaN tilt."""
+    theta = float(theta_deg)
+    if math.isnan(theta):
+        return None
+    low, high = window.tilts(g0)
+    if math.isnan(low) or theta < low:
+        return "below"
+    return "inside" if theta <= high else "outside"
+
+
+def _loss_at(shapes, qs, values, sector, tol):
+    """The first sign change of ``values`` (leading Re σ of ``sector``) along the
+    branch's shapes, refined by brentq and typed by the eigenvalue there; None if none."""
+    for i in range(1, len(values)):
+        if values[i - 1] < 0.0 <= values[i]:
+            q = branch.rate_crossing(shapes[i], qs[i - 1], qs[i], tol, sector=sector)
+            shape = branch.solve_steady(shapes[i].x, q, shapes[i].w, symmetric=True)
+            lead = branch.stability(shape)[f"leading_{sector}"]
+            kind = "hopf" if abs(lead.imag) > HOPF_IM_TOL else "steady"
+            return StabilityLoss(q=q, kind=kind, sector=sector.replace("_", "-"),
+                                 frequency=abs(lead.imag) if kind == "hopf" else 0.0)
+    return None
+
+
+def _fold(shapes):
+    """The fold: the largest q of the quadratic through the three points around the
+    largest q along the branch, in cumulative arclength of (x, q)."""
+    qs = np.array([s.q for s in shapes])
+    i = int(np.argmax(qs))
+    if i in (0, len(qs) - 1):
+        return None
+    pts = [np.concatenate([s.x.ravel(), [s.q]]) for s in shapes[i - 1:i + 2]]
+    arc = np.concatenate([[0.0], np.cumsum([np.linalg.norm(b - a) for a, b in zip(pts, pts[1:])])])
+    c2, c1, c0 = np.polyfit(arc, qs[i - 1:i + 2], 2)
+    return StabilityLoss(q=float(c0 - c1 * c1 / (4.0 * c2)), kind="fold", sector=None,
+                         frequency=math.nan)
+
+
+@functools.lru_cache(maxsize=8)
+def stability_losses(n=DEFAULT_WINDOW_N, w=DEFAULT_W, q_max=80.0, tol=1e-10):
+    """The losses of stability along the branch's in-plane-stable half, in order of q:
+    the first out-of-plane and in-plane crossings (Hopf or steady) and the fold, as a
+    :class:`RestWindow` (computed once per process and arguments; about a minute of one
+    core at n = 16)."""
+    n = validation.check_count("n", n, 4, validation.MAX_BRANCH_N,
+                               "the continuation's cost grows like n^3 per point")
+    half = branch.upper_half(n, q_max, w, step_max=WINDOW_STEP_MAX, stop_after_fold=True)
+    shapes = half.shapes
+    qs = [s.q for s in shapes]
+    spectra = [branch.stability(s) for s in shapes]
+    losses = []
+    for sector in ("out_of_plane", "in_plane"):
+        rates = [spectrum[f"leading_{sector}"].real for spectrum in spectra]
+        loss = _loss_at(shapes, qs, rates, sector, tol)
+        if loss is not None:
+            losses.append(loss)
+    fold = _fold(shapes)
+    if fold is not None:
+        losses.append(fold)
+    if not losses:
+        raise ValueError(f"no loss of stability along the branch up to q = {q_max} at n = {n}")
+    return RestWindow(n=n, w=float(w), q_circle=float(half.q_circle),
+                      losses=tuple(sorted(losses, key=lambda loss: loss.q)))
+
+
+def rest_window(g0, n=DEFAULT_WINDOW_N, w=DEFAULT_W):
+    """The tilts (θ_low, θ_high), in degrees, at which a loop at ``g0`` can rest on the
+    stable steady branch (module docstring), with the :class:`RestWindow` they come from.
+
+    Examples
+    --------
+    The window at the top of the paper's range (about a minute of one core):
+
+    >>> low, high, window = rest_window(350.0)                      # doctest: +SKIP
+    >>> round(low, 2), round(high, 2), window.losses[0].kind        # doctest: +SKIP
+    (4.38, 18.78, 'hopf')
+    """
+    window = stability_losses(n, w)
+    return (*window.tilts(g0), window)

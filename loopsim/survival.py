@@ -1,0 +1,173 @@
+"""How long loops take to come to rest: settling times as censored data.
+
+A run *comes to rest* at ``t_final`` when it stops early because it passed the steady
+test (``stop_reason`` "steady": no invariant changed by more than ``steady_tol`` per
+``steady_interval``; ``loopsim.integrators.control``), so its settling time is
+observed, late by at most about one ``steady_interval``.  A run that reached its
+``t_end`` without passing it is *censored* there: it was not at rest by ``t_end``,
+and nothing is known after.  Failed runs carry no settling time and are left out
+(counted apart).  Times are in t_u (``loopsim.defaults``).
+
+With ``T_i`` the observed time of run i and ``d_i`` whether it came to rest, the
+survival of "not yet at rest" is the Kaplan–Meier product
+
+    S(t) = ∏_{t_j ≤ t} (1 − d_j / r_j)      (r_j: runs still observed just before t_j)
+
+(``scipy.stats.ecdf`` on ``scipy.stats.CensoredData``), with the 95 % exponential
+Greenwood ("log-log") band.  Per cell (:func:`settling_statistics`):
+
+* ``p_rest_t10``: P(at rest by the paper's horizon t = 10) = 1 − S(10), with its
+  95 % interval: the Wilson interval where every run was observed to at least t = 10
+  (no censoring before it: the estimate is then a binomial proportion), the KM band
+  otherwise;
+* ``t_rest_median`` (the first t with S(t) ≤ 1/2) with the times where the band's
+  limits cross 1/2 (Brookmeyer–Crowley), and ``t_rest_q95`` (the first t with
+  S(t) ≤ 0.05): NaN where the curve does not reach that far;
+* the escape rate after the horizon, from the tail t > t0 = 10 taken as exponential:
+  λ = D / E, D the runs that came to rest after t0, E the total time observed after
+  t0 (Σ max(0, T_i − t0)), with the exact Poisson interval
+  [χ²_{0.025}(2D) / 2E, χ²_{0.975}(2D + 2) / 2E]; NaN where D < ``MIN_TAIL_EVENTS``
+  (the upper limit alone says little then; ``escape_events`` and ``tail_time`` still
+  say what the tail holds).
+
+A survival that falls to zero within the runs' horizon is a transient; one that levels
+off at S > 0 with runs censored at a long t_end is a lasting tumbling state (or a
+transient longer than that horizon): :func:`survival_curve` gives the curve and band.
+"""
+import math
+import warnings
+
+import numpy as np
+import pandas as pd
+from scipy import stats
+
+#: The paper's horizon, t = 10 t_u: P(at rest by then), and the start of the tail.
+PAPER_HORIZON = 10.0
+#: Fewest runs coming to rest after the horizon for an escape rate.
+MIN_TAIL_EVENTS = 3
+#: Confidence level of every interval here.
+LEVEL = 0.95
+#: The columns :func:`settling_statistics` returns, in order.
+SETTLING_COLUMNS = ("rest_observed", "at_rest", "p_rest_t10", "p_rest_t10_low",
+                    "p_rest_t10_high", "t_rest_median", "t_rest_median_low",
+                    "t_rest_median_high", "t_rest_q95", "escape_events", "tail_time",
+                    "escape_rate", "escape_rate_low", "escape_rate_high")
+
+
+def settling_times(frame):
+    """(times, at_rest) of the runs of ``frame`` that did not fail: ``t_final`` and
+    whether it is a settling time (``stop_reason`` "steady") or a censoring time
+    (reached ``t_end``).  Rows with another ``stop_reason`` (failures) or none are
+    left out."""
+    reason = frame["stop_reason"]
+    keep = reason.isin(("steady", "t_end")).to_numpy(bool)
+    times = frame["t_final"].to_numpy(float)[keep]
+    return times, reason.to_numpy(object)[keep] == "steady"
+
+
+def _censored(times, at_rest):
+    return stats.CensoredData(uncensored=times[at_rest], right=times[~at_rest])
+
+
+def kaplan_meier(times, at_rest, level=LEVEL):
+    """The Kaplan–Meier survival of "not yet at rest" (module docstring) and its
+    log-log band, as three ``scipy.stats`` EmpiricalDistributionFunction objects
+    (estimate, low, high); None if no run came to rest."""
+    times, at_rest = np.asarray(times, float), np.asarray(at_rest, bool)
+    if not at_rest.any():
+        return None
+    sf = stats.ecdf(_censored(times, at_rest)).sf
+    with warnings.catch_warnings():
+        # undefined where S is 0 or 1, as scipy warns: _band_at fills those places
+        warnings.simplefilter("ignore", RuntimeWarning)
+        band = sf.confidence_interval(level, method="log-log")
+    return sf, band.low, band.high
+
+
+def _band_at(curve, estimate, t):
+    """The band's limit ``curve`` at times t, defined where S is 0 or 1 as S itself
+    (the log-log band is undefined there, and degenerate)."""
+    values = np.asarray(curve.evaluate(t), float)
+    fill = np.asarray(estimate.evaluate(t), float)
+    return np.where(np.isfinite(values), values, fill)
+
+
+def survival_curve(times, at_rest, level=LEVEL):
+    """S(t) as a step table: columns ``t`` (0, then every settling time), ``sf``,
+    ``sf_low``, ``sf_high`` (the value from t on), and ``at_risk`` (runs still observed
+    just before t).  Empty if no run came to rest."""
+    times, at_rest = np.asarray(times, float), np.asarray(at_rest, bool)
+    km = kaplan_meier(times, at_rest, level)
+    if km is None:
+        return pd.DataFrame(columns=["t", "sf", "sf_low", "sf_high", "at_risk"])
+    sf, low, high = km
+    t = np.concatenate([[0.0], np.unique(times[at_rest])])
+    at_risk = np.array([int(np.sum(times >= s)) for s in t])
+    return pd.DataFrame(dict(t=t, sf=sf.evaluate(t), sf_low=_band_at(low, sf, t),
+                             sf_high=_band_at(high, sf, t), at_risk=at_risk))
+
+
+def _first_at_or_below(curve_values, t, level):
+    hit = np.nonzero(curve_values <= level)[0]
+    return float(t[hit[0]]) if hit.size else math.nan
+
+
+def escape_rate(times, at_rest, onset=PAPER_HORIZON, level=LEVEL):
+    """(rate, low, high, events, exposure) of the exponential tail after ``onset``
+    (module docstring); rate and limits NaN where events < MIN_TAIL_EVENTS."""
+    times, at_rest = np.asarray(times, float), np.asarray(at_rest, bool)
+    events = int(np.sum(at_rest & (times > onset)))
+    exposure = float(np.sum(np.maximum(0.0, times - onset)))
+    if events < MIN_TAIL_EVENTS or exposure <= 0.0:
+        return math.nan, math.nan, math.nan, events, exposure
+    alpha = 1.0 - level
+    low = stats.chi2.ppf(alpha / 2, 2 * events) / (2 * exposure)
+    high = stats.chi2.ppf(1 - alpha / 2, 2 * events + 2) / (2 * exposure)
+    return events / exposure, float(low), float(high), events, exposure
+
+
+def settling_statistics(frame, horizon=PAPER_HORIZON, level=LEVEL):
+    """The settling statistics of one cell's rows (``SETTLING_COLUMNS``, module
+    docstring): ``rest_observed`` runs (not failed), ``at_rest`` of them came to rest,
+    P(at rest by ``horizon``) with its interval, the median settling time with its
+    interval, the time by which 95 % rest, and the escape rate after ``horizon``."""
+    times, at_rest = settling_times(frame)
+    out = dict.fromkeys(SETTLING_COLUMNS, math.nan)
+    out.update(rest_observed=int(times.size), at_rest=int(at_rest.sum()))
+    if not times.size:
+        out.update(escape_events=0, tail_time=0.0)
+        return out
+    rested_by = int(np.sum(at_rest & (times <= horizon)))
+    if np.all(at_rest & (times <= horizon) | (times >= horizon)):
+        out["p_rest_t10"] = rested_by / times.size
+        interval = stats.binomtest(rested_by, times.size).proportion_ci(level, method="wilson")
+        out["p_rest_t10_low"], out["p_rest_t10_high"] = interval.low, interval.high
+    km = kaplan_meier(times, at_rest, level)
+    if km is not None:
+        sf, low, high = km
+        grid = np.unique(times[at_rest])
+        estimate = sf.evaluate(grid)
+        if math.isnan(out["p_rest_t10"]):
+            out["p_rest_t10"] = 1.0 - float(sf.evaluate(horizon))
+            out["p_rest_t10_low"] = 1.0 - float(_band_at(high, sf, horizon))
+            out["p_rest_t10_high"] = 1.0 - float(_band_at(low, sf, horizon))
+        out["t_rest_median"] = _first_at_or_below(estimate, grid, 0.5)
+        out["t_rest_median_low"] = _first_at_or_below(_band_at(low, sf, grid), grid, 0.5)
+        out["t_rest_median_high"] = _first_at_or_below(_band_at(high, sf, grid), grid, 0.5)
+        out["t_rest_q95"] = _first_at_or_below(estimate, grid, 0.05)
+    elif math.isnan(out["p_rest_t10"]):
+        out["p_rest_t10"] = 0.0
+    (out["escape_rate"], out["escape_rate_low"], out["escape_rate_high"],
+     out["escape_events"], out["tail_time"]) = escape_rate(times, at_rest, horizon, level)
+    return out
+
+
+def window_counts(frame, window):
+    """``rest_inside``, ``rest_below``, ``rest_outside``: the rows of ``frame`` that came to
+    rest (``stop_reason`` steady), by where their terminal tilt lies in the stable
+    branch's tilt window at their g0 (``window``: a
+    ``loopsim.stability.rest_window.RestWindow``, its ``classify`` and ``CLASSES``)."""
+    rested = frame[frame["stop_reason"].eq("steady")]
+    where = [window.classify(theta, g0)
+             for theta, g0 in zip(rested["theta_final_deg"], rested["g0"])]
+    return {f"rest_{name}": int(sum(w == name for w in where)) for name in window.CLASSES}

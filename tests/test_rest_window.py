@@ -1,0 +1,74 @@
+"""Where loops can rest (loopsim.stability.rest_window): the losses of stability along the
+steady branch and the tilt windows they give, against the independent computation of
+../shared/physics-notes.md ("Where 3D loops come to rest", 2026-12-06/07): out of plane a
+Hopf point at q = 37.553191 (Im sigma = 22.088), in plane a Hopf point at q = 45.443265
+(Im sigma = 66.569), the fold near q = 46.38; windows 6.71-29.53 deg at g0 = 228.6 and
+4.4-18.8 deg at g0 = 350."""
+import json
+import math
+import subprocess
+import sys
+
+import pytest
+
+from loopsim.stability import rest_window as rw
+
+
+@pytest.fixture(scope="module")
+def window():
+    return rw.stability_losses(rw.DEFAULT_WINDOW_N)
+
+
+def test_losses_along_the_branch(window):
+    out, inp, fold = window.losses
+    assert (out.kind, out.sector) == ("hopf", "out-of-plane")
+    assert out.q == pytest.approx(37.553191, abs=1e-5)
+    assert out.frequency == pytest.approx(22.088, abs=1e-3)
+    assert (inp.kind, inp.sector) == ("hopf", "in-plane")
+    assert inp.q == pytest.approx(45.443265, abs=1e-5)
+    assert inp.frequency == pytest.approx(66.569, abs=1e-3)
+    assert fold.kind == "fold" and fold.q == pytest.approx(46.38, abs=0.01)
+    assert window.q_circle == pytest.approx(8.9000904456, abs=1e-8)
+    assert window.q_loss == out.q
+
+
+@pytest.mark.parametrize("g0, low, high, digits", [(228.57142857142856, 6.71, 29.53, 2),
+                                                   (350.0, 4.4, 18.8, 1)])
+def test_tilt_windows(window, g0, low, high, digits):
+    lo, hi = window.tilts(g0)
+    assert round(lo, digits) == low and round(hi, digits) == high
+    # the edges are the q's: g0 sin(theta) / 3
+    assert g0 * math.sin(math.radians(lo)) / 3 == pytest.approx(window.q_circle)
+    assert g0 * math.sin(math.radians(hi)) / 3 == pytest.approx(window.q_loss)
+
+
+def test_window_edges_at_small_and_moderate_g0():
+    # below 3 q_c no tilt reaches the branch; below 3 q_loss every tilt above q_c is stable
+    assert rw.tilt_window(20.0, 8.9, 37.55)[0] != rw.tilt_window(20.0, 8.9, 37.55)[0]  # NaN
+    assert rw.tilt_window(60.0, 8.9, 37.55)[1] == 90.0
+    with pytest.raises(ValueError, match="g0"):
+        rw.tilt_window(-1.0, 8.9, 37.55)
+
+
+def test_classify_rest():
+    window = rw.RestWindow(n=16, w=10.0, q_circle=8.9, losses=(
+        rw.StabilityLoss(q=37.55, kind="hopf", sector="out-of-plane", frequency=22.0),))
+    low, high = window.tilts(350.0)
+    assert rw.classify_rest(low - 0.1, 350.0, window) == "below"
+    assert rw.classify_rest(low + 0.1, 350.0, window) == "inside"
+    assert rw.classify_rest(high + 0.1, 350.0, window) == "outside"
+    assert rw.classify_rest(45.0, 20.0, window) == "below"     # no branch at g0 = 20
+    assert rw.classify_rest(float("nan"), 350.0, window) is None
+
+
+def test_cli_prints_the_window_as_json():
+    # a coarse branch (n = 8) keeps it quick: its first loss is still the out-of-plane Hopf
+    out = subprocess.run([sys.executable, "-m", "loopsim", "rest-window", "--g0", "350,20",
+                          "--n", "8", "--json"], capture_output=True, text=True, check=True)
+    data = json.loads(out.stdout)
+    first = data["losses"][0]
+    assert (first["kind"], first["sector"], data["n"]) == ("hopf", "out-of-plane", 8)
+    assert first["q"] == data["q_loss"]
+    high = data["windows"][0]["theta_high_deg"]
+    assert 350 * math.sin(math.radians(high)) / 3 == pytest.approx(first["q"])
+    assert data["windows"][1]["theta_low_deg"] is None      # g0 = 20 < 3 q_c: NaN -> null

@@ -1,0 +1,126 @@
+"""Settling times as censored data (loopsim.survival): the Kaplan-Meier estimate against
+a textbook table and a plain-NumPy product-limit twin, the escape rate's Poisson interval
+against Garwood's table, and the per-cell statistics on fabricated cells."""
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from loopsim import outcome_statistics, survival
+
+
+def product_limit(times, at_rest, t):
+    """Plain product-limit estimate S(t) = prod over event times t_j <= t of (1 - d_j / r_j)."""
+    times, at_rest = np.asarray(times, float), np.asarray(at_rest, bool)
+    s = 1.0
+    for tj in np.unique(times[at_rest]):
+        if tj > t:
+            break
+        d = np.sum((times == tj) & at_rest)
+        r = np.sum(times >= tj)
+        s *= 1.0 - d / r
+    return s
+
+
+# Freireich et al. (1963), 6-MP arm (Klein & Moeschberger, Survival Analysis, table 4.1A):
+# remission times in weeks, + marks a censored time.
+SIX_MP = "6 6 6 6+ 7 9+ 10 10+ 11+ 13 16 17+ 19+ 20+ 22 23 25+ 32+ 32+ 34+ 35+".split()
+SIX_MP_TIMES = np.array([float(v.rstrip("+")) for v in SIX_MP])
+SIX_MP_EVENT = np.array([not v.endswith("+") for v in SIX_MP])
+#: the book's Kaplan-Meier column at each event time
+SIX_MP_KM = {6: 0.857, 7: 0.807, 10: 0.753, 13: 0.690, 16: 0.627, 22: 0.538, 23: 0.448}
+
+
+def test_kaplan_meier_reproduces_the_textbook_table():
+    sf, low, high = survival.kaplan_meier(SIX_MP_TIMES, SIX_MP_EVENT)
+    for t, expected in SIX_MP_KM.items():
+        assert sf.evaluate(t) == pytest.approx(expected, abs=5e-4)
+        assert low.evaluate(t) < expected < high.evaluate(t)
+    curve = survival.survival_curve(SIX_MP_TIMES, SIX_MP_EVENT)
+    assert list(curve["t"]) == [0.0, 6, 7, 10, 13, 16, 22, 23]
+    assert list(curve["at_risk"]) == [21, 21, 17, 15, 12, 11, 7, 6]
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_kaplan_meier_matches_a_plain_product_limit(seed):
+    rng = np.random.default_rng(seed)
+    times = np.round(rng.exponential(8.0, 40), 1)       # rounded: ties happen
+    censor = rng.uniform(5.0, 30.0, 40)
+    at_rest = times <= censor
+    observed = np.minimum(times, censor)
+    sf, _, _ = survival.kaplan_meier(observed, at_rest)
+    for t in np.linspace(0.0, 35.0, 71):
+        assert sf.evaluate(t) == pytest.approx(product_limit(observed, at_rest, t), abs=1e-12)
+
+
+def test_escape_rate_uses_the_exact_poisson_interval():
+    # three runs come to rest after t = 10, at 12, 14, 16; two are censored at 20: the
+    # exposure after 10 is 2 + 4 + 6 + 10 + 10 = 32; Garwood's 95 % interval for a
+    # Poisson count of 3 is [0.6187, 8.7673]
+    times = np.array([5.0, 12.0, 14.0, 16.0, 20.0, 20.0])
+    at_rest = np.array([True, True, True, True, False, False])
+    rate, low, high, events, exposure = survival.escape_rate(times, at_rest)
+    assert (events, exposure) == (3, 32.0)
+    assert rate == pytest.approx(3 / 32)
+    assert low == pytest.approx(0.6187 / 32, rel=1e-3)
+    assert high == pytest.approx(8.7673 / 32, rel=1e-3)
+    # two events: too few for a rate, the tail still described
+    rate, low, high, events, exposure = survival.escape_rate(times[:3], at_rest[:3])
+    assert math.isnan(rate) and math.isnan(high) and events == 2
+
+
+def test_escape_rate_estimates_a_known_exponential_tail():
+    rng = np.random.default_rng(1)
+    times = 10.0 + rng.exponential(1 / 0.2, 4000)        # rate 0.2 after t = 10
+    at_rest = times <= 40.0
+    rate, low, high, _, _ = survival.escape_rate(np.minimum(times, 40.0), at_rest)
+    assert low < 0.2 < high and high - low < 0.03
+
+
+def cell(times, reasons, g0=350.0, theta=18.0, tilts=None):
+    """A fabricated cell: one row per run."""
+    k = len(times)
+    return pd.DataFrame(dict(
+        g0=g0, theta0_deg=theta, seed=range(k), t_final=times, stop_reason=reasons,
+        regime="3d", resolved=True, determined=pd.NA, twin_nfev=0, nfev=1, wall_s=1.0,
+        theta_final_deg=tilts if tilts is not None else [10.0] * k, aspect_ratio=2.0,
+        q_final=1.0))
+
+
+def test_settling_statistics_of_a_cell():
+    # the eight independent runs at (350, 18 deg) of issue 53, all at rest by t = 30,
+    # and two failures, which carry no time
+    times = [4.8, 5.5, 6.4, 7.6, 9.4, 9.9, 16.4, 18.4, 3.0, 2.0]
+    reasons = ["steady"] * 8 + ["nan in the state", "step size underflow"]
+    out = survival.settling_statistics(cell(times, reasons))
+    assert (out["rest_observed"], out["at_rest"]) == (8, 8)
+    assert out["p_rest_t10"] == 6 / 8                     # binomial: all observed past 10
+    assert (out["p_rest_t10_low"], out["p_rest_t10_high"]) == pytest.approx(
+        outcome_statistics.wilson_interval(6, 8))
+    assert out["t_rest_median"] == 7.6                    # S(7.6) = 4/8
+    assert out["t_rest_q95"] == 18.4
+    assert out["t_rest_median_low"] <= 7.6 <= out["t_rest_median_high"]
+    assert out["escape_events"] == 2 and math.isnan(out["escape_rate"])
+    assert out["tail_time"] == pytest.approx(6.4 + 8.4)
+
+
+def test_censoring_before_the_horizon_uses_kaplan_meier():
+    # censored at t_end = 5 and 8 (runs with a short t_end): P(at rest by 10) from the
+    # product limit, not the plain share
+    times = [2.0, 5.0, 6.0, 8.0, 12.0, 12.0]
+    reasons = ["steady", "t_end", "steady", "t_end", "t_end", "t_end"]
+    out = survival.settling_statistics(cell(times, reasons))
+    expected = 1.0 - product_limit(times, [True, False, True, False, False, False], 10.0)
+    assert out["p_rest_t10"] == pytest.approx(expected)
+    assert out["p_rest_t10_low"] <= expected <= out["p_rest_t10_high"]
+    assert math.isnan(out["t_rest_median"])               # S stays above 1/2
+
+
+def test_summarize_adds_the_settling_columns_only_where_rows_were_tested():
+    frame = cell([4.0, 10.0, 10.0, 6.0], ["steady", "t_end", "t_end", "steady"])
+    table = outcome_statistics.summarize(frame)
+    assert table.loc[0, "at_rest"] == 2 and table.loc[0, "p_rest_t10"] == 0.5
+    frame.attrs["loopsim"] = {"sweep_config": {"early_stop": False}}
+    untested = outcome_statistics.summarize(frame)
+    assert "p_rest_t10" not in untested or untested["p_rest_t10"].isna().all()
