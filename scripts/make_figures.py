@@ -59,7 +59,7 @@ The steps (the runs), with the figures that need them:
 
 The figure suite's own runs (all but ``main_job`` and ``seed_cells``) skip the twin
 (``--no-twin``): these figures draw no determinacy, and the twin would cost 1.5-2.5x.
-work_precision (docs/performance.md) runs ``benchmarks/bench_trajectory.py`` itself
+work_precision (docs/studies/performance.md) runs ``benchmarks/bench_trajectory.py`` itself
 (``WORK_PRECISION``: about 15 minutes on one core); paper_range (docs/distributions.md)
 runs ``scripts/paper_range_study.py``, which also writes its tables into data/;
 paper_range_top redraws the top of that range from the sweeps committed under
@@ -107,7 +107,7 @@ FIGURE_DPI = {"fig6_evolution": 80}
 #: each at ``--n auto`` with 121 snapshots, drawn by ``loopsim animate`` (60 frames).
 MOVIES = (("movie_stable", "10", "30", "6"), ("movie_in_plane", "60", "30", "6"),
           ("movie_3d", "150", "60", "3"))
-#: docs/performance.md's work-precision figure: ``benchmarks/bench_trajectory.py`` (terminal
+#: docs/studies/performance.md's work-precision figure: ``benchmarks/bench_trajectory.py`` (terminal
 #: tilt at t = 2 against a same-start radau5 rtol 1e-11 run; radau5 now and at the
 #: benchmark's baseline revision, scipy's LSODA and BDF on loopsim's compiled kernels), and
 #: its --quick stand-in (one case at n = 8, t = 0.1, two tolerances, no baseline).

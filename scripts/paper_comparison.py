@@ -1,4 +1,4 @@
-"""Numbers of docs/paper-comparison.md, from the tables scripts/make_figures.py writes.
+"""Numbers of docs/studies/paper-comparison.md, from the tables scripts/make_figures.py writes.
 
 Usage: python scripts/paper_comparison.py [--runs runs] [--save-n6 data/phase_n6_cases.parquet]
 

@@ -79,8 +79,10 @@ TABLE_RULE = re.compile(r"^\s*\|?\s*:?-{3,}:?\s*(?:\|\s*:?-{3,}:?\s*)*\|?\s*$")
 
 
 def pages():
-    """Every Markdown page of docs/, by file name."""
-    return sorted(name for name in os.listdir(DOCS) if name.endswith(".md"))
+    """Every Markdown page under docs/ (the study reports of docs/studies/ included), by
+    its path relative to docs/."""
+    return sorted(os.path.relpath(os.path.join(folder, name), DOCS)
+                  for folder, _, names in os.walk(DOCS) for name in names if name.endswith(".md"))
 
 
 def page_text(name):
