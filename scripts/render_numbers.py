@@ -39,6 +39,8 @@ SPAN = re.compile(r"<!-- num:([\w.\-]+) -->(.*?)<!-- /num -->", re.S)
 Q_STAR = 8.9001
 #: What paper-comparison calls a near-horizontal circle.
 FLAT_TILT_DEG, ROUND_ASPECT = 15.0, 1.05
+#: The paper's grid above g0 = 250 at 24-90 deg: 5 values of g0 (252.9-350) x 12 of theta0.
+TOP_CELLS = 5 * 12
 
 
 # ---------------------------------------------------------------------------------
@@ -177,6 +179,9 @@ def _top_costs():
         "top.n-used": "–".join(str(int(v)) for v in sorted({runs["n_used"].min(), runs["n_used"].max()})),
         "top.twin-over-run": f"{runs['twin_nfev'].sum() / runs['nfev'].sum():.2f}×",
         "top.unsteady": count((runs["terminal_state"] == "unsteady").sum()),
+        # the 60 cells of g0 >= 252.9 at 24-90 deg, 8 seeds each, at the median sample
+        "top.cells60-seeds8-hours": f"{TOP_CELLS * 8 * runs['wall_s'].median() / 3600:.0f} h",
+        "top.cells60-seeds8-hours-twins": f"{TOP_CELLS * 8 * runs['wall_s'].median() * (1 + runs['twin_nfev'].sum() / runs['nfev'].sum()) / 3600:.0f} h",
     }
 
 

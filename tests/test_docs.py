@@ -218,15 +218,15 @@ FACTS = {
     # the n --n auto chooses for each regime
     "--n auto's n per regime": (
         r"stable loops (?:are resolved|need) at n = \d|in-plane loops need n = \d"
-        r"|\| stable \(q0 below 8\.9001\) \| \d", "README.md"),
+        r"|\| stable \(q0 below 8\.9001\) \| \d", os.path.join("studies", "n-auto.md")),
     # what the twin costs
     "the twin's cost": (
         r"halves the cost|about doubles|twin adds|2\.0[–-]3\.5|case costs [\d.–-]+ times"
         r"|twin costs [\d.]+[–-][\d.]+ times",
-        "auto-and-determinacy.md"),
+        os.path.join("studies", "n-auto.md")),
     # how far a 1e-6 change of the start moves the terminal tilt
     "a changed start's effect on the tilt": (
-        r"(?:start|perturb)[^.]{0,80}?by up to \d+°", "auto-and-determinacy.md"),
+        r"(?:start|perturb)[^.]{0,80}?by up to \d+°", os.path.join("studies", "n-auto.md")),
 }
 
 
