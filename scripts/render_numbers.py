@@ -137,6 +137,7 @@ def _n6_counts():
         "n6.3d-less-tilted-percent": f"{100 * (d3['theta_final_deg'] < d3['theta0_deg']).mean():.0f} %",
         "n6.3d-flat": count(flat.sum()),
         "n6.3d-circles": count((flat & (d3["aspect_ratio"] < ROUND_ASPECT)).sum()),
+        "n6.3d-circles-percent": f"{100 * (flat & (d3['aspect_ratio'] < ROUND_ASPECT)).mean():.0f} %",
         "n6.3d-tilt-quartiles": quartiles(d3["theta_final_deg"], 1),
         "n6.3d-aspect-quartiles": quartiles(d3["aspect_ratio"], 2),
         "n6.3d-q-final-span": f"{d3['q_final'].min():.1f} to {d3['q_final'].max():.0f}",
@@ -146,6 +147,8 @@ def _n6_counts():
         "n6.low-q": count(len(low)),
         "n6.low-q-circles": count((low["aspect_ratio"] <= 1.01).sum()),
         "n6.low-q-others": count((low["aspect_ratio"] > 1.01).sum()),
+        "n6.low-q-others-steady": count(((low["aspect_ratio"] > 1.01)
+                                         & (low["stop_reason"] == "steady")).sum()),
         "n6.3d-length-error-median": f"{d3['length_error_max'].median():.3f}",
         "n6.3d-length-error-max": f"{d3['length_error_max'].max():.2f}",
         "n6.settling-max-stable": f"{n6_regime('stable')['settling_angle_deg'].max():.4f}°",
@@ -158,6 +161,28 @@ def _n6_counts():
         "n6.band-cases": count(len(band)),
         "n6.band-3d": count((band["regime"] == "3d").sum()),
         "n6.band-in-plane": count((band["regime"] == "in-plane").sum()),
+    }
+
+
+def _n6_labels():
+    """How the regime thresholds (1 deg of tilt, 0.01 of aspect ratio) cut the n = 6 grid."""
+    frame = n6()
+    tilt = (frame["theta_final_deg"] - frame["theta0_deg"]).abs()
+    aspect = (frame["aspect_ratio"] - frame["aspect_ratio_initial"]).abs()
+    small, middle = frame[tilt < 0.1], frame[(tilt >= 0.1) & (tilt <= 1)]
+    continuum = frame[(tilt > 1) & (tilt <= 5)]
+    return {
+        "n6.tilt-below-0.1": count(len(small)),
+        "n6.tilt-below-0.1-stable": count((small["regime"] == "stable").sum()),
+        "n6.tilt-below-0.1-in-plane": count((small["regime"] == "in-plane").sum()),
+        "n6.tilt-0.1-to-1": count(len(middle)),
+        "n6.tilt-0.1-to-1-regimes": ", ".join(sorted(set(middle["regime"]))),
+        "n6.tilt-0.1-to-1-q0": span(middle["q0"], 1),
+        "n6.tilt-1-to-5": count(len(continuum)),
+        "n6.tilt-above-10": count((tilt > 10).sum()),
+        "n6.aspect-within-0.01": count((aspect <= 0.01).sum()),
+        "n6.aspect-above-0.2": count((aspect > 0.2).sum()),
+        "n6.stable-length-error-max": f"{n6_regime('stable')['length_error_max'].max():.1e}",
     }
 
 
@@ -201,7 +226,7 @@ def _convergence():
 
 
 #: Groups of keys, each computed together from one table; a key's function is its group's.
-GROUPS = (_n6_counts, _grid_costs, _top_costs, _convergence)
+GROUPS = (_n6_counts, _n6_labels, _grid_costs, _top_costs, _convergence)
 
 
 @functools.lru_cache(maxsize=None)
