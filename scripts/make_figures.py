@@ -416,9 +416,10 @@ def main():
             print(f"{name}: {', '.join(sorted(needed_steps([name], table))) or '(no run)'}")
         return
     fig = os.path.join(args.runs, "fig")
-    os.makedirs(fig, exist_ok=True)
-    resolved_cases(os.path.join(fig, "resolved_cases.csv"), args.quick)
-    n24_cases(os.path.join(fig, "n24_cases.csv"))
+    if not args.dry_run:  # --dry-run prints the commands and writes nothing
+        os.makedirs(fig, exist_ok=True)
+        resolved_cases(os.path.join(fig, "resolved_cases.csv"), args.quick)
+        n24_cases(os.path.join(fig, "n24_cases.csv"))
     need = needed_steps(names, table) | ({"resolved_n24"} if args.n24 else set())
     start = time.monotonic()
     for step, (output, command, capped) in all_steps.items():
