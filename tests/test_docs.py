@@ -214,7 +214,7 @@ FACTS = {
     # the resolved reference's orders and resolved rows
     "the resolved reference's n_used and resolved counts": (
         r"n_used:? \d+ \(\d+ cases?\)|\d+ of (?:the|its) 20 (?:rows|cases) are `resolved`"
-        r"|\d+ rows are `resolved`", "figures.md"),
+        r"|\d+ rows are `resolved`", os.path.join("studies", "figure-runs.md")),
     # the n --n auto chooses for each regime
     "--n auto's n per regime": (
         r"stable loops (?:are resolved|need) at n = \d|in-plane loops need n = \d"
