@@ -19,7 +19,8 @@ The tables:
   regimes); the table is the run on the commit its metadata names.
 * ``data/seeds_auto_grid_summary.parquet``: the main job's 72 points at ``--seeds auto``.
 * ``data/paper_range_runs/paper_range_top24``: the runs of g0 = 252.9-350 at 24-30 deg.
-* ``data/convergence_top.parquet``: the convergence study at the top of the range.
+* ``data/convergence_top.parquet`` and ``data/convergence_runs``: the convergence study at
+  the top of the range.
 """
 import argparse
 import functools
@@ -210,6 +211,18 @@ def _top_costs():
     }
 
 
+def _tumbling_samples():
+    """What a sample costs at (350, 18 deg) on the current radau5 (the convergence study's
+    ``jmid_t18``: the defaults with the Jacobian inside the step), 16 seeds to t = 10."""
+    runs = table(os.path.join("convergence_runs", "jmid_t18"))
+    cell = runs[(runs["g0"].round(1) == 350) & (runs["theta0_deg"] == 18)]
+    return {
+        "conv.tumbling-350-seeds": count(len(cell)),
+        "conv.tumbling-350-median": seconds(cell["wall_s"].median()),
+        "conv.tumbling-350-max": seconds(cell["wall_s"].max()),
+    }
+
+
 def _convergence():
     frame = convergence()
     loose = frame[frame["setting"] == "jmid_rtol1e-3"]
@@ -226,7 +239,7 @@ def _convergence():
 
 
 #: Groups of keys, each computed together from one table; a key's function is its group's.
-GROUPS = (_n6_counts, _n6_labels, _grid_costs, _top_costs, _convergence)
+GROUPS = (_n6_counts, _n6_labels, _grid_costs, _top_costs, _tumbling_samples, _convergence)
 
 
 @functools.lru_cache(maxsize=None)
