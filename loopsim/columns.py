@@ -332,7 +332,18 @@ TABLES = {"results": RESULT_COLUMNS, "trajectory": TRAJECTORY_COLUMNS,
           "summary": SUMMARY_COLUMNS, "compare": COMPARE_COLUMNS, "stops": STOP_COLUMNS,
           "convergence": CONVERGENCE_COLUMNS}
 
-if __name__ == "__main__":
-    import sys
+def main(argv=None):
+    """``python -m loopsim.columns [NAME]``: print a column table as Markdown."""
+    import argparse
 
-    print(markdown(TABLES[sys.argv[1] if len(sys.argv) > 1 else "results"]))
+    parser = argparse.ArgumentParser(
+        prog="python -m loopsim.columns",
+        description="Print the declared columns of one of loopsim's tables (unit and "
+        "meaning of each) as a Markdown table.")
+    parser.add_argument("table", nargs="?", default="results", choices=sorted(TABLES),
+                        help="which table (default: results, the sweep's per-case table)")
+    print(markdown(TABLES[parser.parse_args(argv).table]))
+
+
+if __name__ == "__main__":
+    main()

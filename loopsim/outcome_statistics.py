@@ -334,8 +334,11 @@ def compare(a, b, by=None, alpha=0.05, seed=0, resamples=500):
     For each cell both tables hold (the same cells at, say, n = 24 and n = 32, or at two
     tolerances): two-sample Kolmogorov-Smirnov tests of the terminal tilt and aspect
     ratio, the tilt's 1-Wasserstein distance with a bootstrap interval, a chi-square test
-    of the regime counts, and a verdict: ``DIFFERENT`` when any of the three p-values
-    is below alpha / 3 (Bonferroni), else ``SAME``.
+    of the regime counts, and a verdict: "different" when any of the three p-values
+    is below alpha / 3 (Bonferroni), else "indistinguishable at this sample size". The
+    verdict rests on the p-values only. A distance is never negative, so its bootstrap
+    interval lies above the distance of two samples of one distribution (a table
+    compared with itself: 0 with an interval that excludes 0).
 
     Parameters
     ----------
@@ -350,7 +353,9 @@ def compare(a, b, by=None, alpha=0.05, seed=0, resamples=500):
     seed : int, default 0
         Seed of the bootstrap's generator.
     resamples : int, default 500
-        Bootstrap resamples of the Wasserstein interval.
+        Bootstrap resamples of the Wasserstein interval: fewer than the summaries'
+        ``BOOTSTRAP_RESAMPLES``, because each resample recomputes a distance and the
+        interval describes the distance's spread, not the verdict.
 
     Returns
     -------

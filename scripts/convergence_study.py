@@ -1,5 +1,5 @@
-"""Convergence in distribution at the top of the paper's range (docs/distributions.md,
-"Convergence in distribution at the top of the range").
+"""Convergence in distribution at the top of the paper's range
+(docs/studies/convergence-top.md).
 
 Usage: python scripts/convergence_study.py [--runs runs/convergence] [--threads T]
                                            [--loopsim loopsim] [--out data/convergence_top.parquet]

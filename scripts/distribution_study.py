@@ -1,4 +1,4 @@
-"""Outcomes as distributions over a grid of points (docs/distributions.md, the studies).
+"""Outcomes as distributions over a grid of points (docs/studies/seeds.md).
 
 Usage: python scripts/distribution_study.py [--runs runs/distributions] [--threads T]
                                             [--g0 30,60,100] [--theta0 30,60]

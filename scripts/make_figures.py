@@ -36,15 +36,15 @@ The steps (the runs), with the figures that need them:
 * ``main_job``: the README's main job, its exact command (72 loops at ``--n auto``,
   with twins) into ``runs/phase``: phase_main, fig7_q_tilt_main, fig8_aspect_main (Figs.
   7 and 8 of a resolved grid);
-* ``seeds_auto_study``: docs/distributions.md's study, ``--seeds auto`` (at most 32) at
+* ``seeds_auto_study``: docs/studies/seeds.md's study, ``--seeds auto`` (at most 32) at
   ``--n auto`` with twins over g0 = 30, 60, 100 x θ0 = 30, 60°: seeds_auto_study
   (``loopsim summary --figure``; ``scripts/distribution_study.py`` runs the same sweep
   and its stricter-tolerance check);
-* ``seeds_auto_grid``: docs/distributions.md's grid study, the main job's 72 points at
+* ``seeds_auto_grid``: docs/studies/seeds.md's grid study, the main job's 72 points at
   ``--seeds auto`` (at most 16) with twins: seeds_auto_grid (``loopsim summary
   --figure``; ``scripts/distribution_study.py`` runs the same sweep and its resolution
   check);
-* ``seed_cells``: docs/distributions.md's four cells (g0 = 100, 150 x θ0 = 45, 60°),
+* ``seed_cells``: docs/studies/seeds.md's four cells (g0 = 100, 150 x θ0 = 45, 60°),
   16 seeds each at ``--n auto`` with twins: seed_cells (``loopsim summary --figure``);
 * ``nonlocal_eps1e-2``, ``nonlocal_eps1e-3``: the main job's grid at ``--n auto`` under
   nonlocal SBT (``--model nonlocal --slenderness``; at 1e-2 the ladder ends at n = 10):
@@ -59,12 +59,12 @@ The steps (the runs), with the figures that need them:
 
 The figure suite's own runs (all but ``main_job`` and ``seed_cells``) skip the twin
 (``--no-twin``): these figures draw no determinacy, and the twin would cost 1.5-2.5x.
-work_precision (docs/performance.md) runs ``benchmarks/bench_trajectory.py`` itself
-(``WORK_PRECISION``: about 15 minutes on one core); paper_range (docs/distributions.md)
+work_precision (docs/studies/performance.md) runs ``benchmarks/bench_trajectory.py`` itself
+(``WORK_PRECISION``: about 15 minutes on one core); paper_range (docs/studies/paper-range.md)
 runs ``scripts/paper_range_study.py``, which also writes its tables into data/;
 paper_range_top redraws the top of that range from the sweeps committed under
 data/paper_range_runs (``paper_range_study.py --top --read-only``: the parts themselves
-take hours each and run apart, see docs/distributions.md).  Fig. 3 and
+take hours each and run apart, see docs/studies/paper-range.md).  Fig. 3 and
 nonlocal_thresholds (the circle's critical q against ε) need no run.  Nothing
 here is random beyond the seeded initial perturbations
 (seed 0 unless stated), so a rerun reproduces the tables.
@@ -107,7 +107,7 @@ FIGURE_DPI = {"fig6_evolution": 80}
 #: each at ``--n auto`` with 121 snapshots, drawn by ``loopsim animate`` (60 frames).
 MOVIES = (("movie_stable", "10", "30", "6"), ("movie_in_plane", "60", "30", "6"),
           ("movie_3d", "150", "60", "3"))
-#: docs/performance.md's work-precision figure: ``benchmarks/bench_trajectory.py`` (terminal
+#: docs/studies/performance.md's work-precision figure: ``benchmarks/bench_trajectory.py`` (terminal
 #: tilt at t = 2 against a same-start radau5 rtol 1e-11 run; radau5 now and at the
 #: benchmark's baseline revision, scipy's LSODA and BDF on loopsim's compiled kernels), and
 #: its --quick stand-in (one case at n = 8, t = 0.1, two tolerances, no baseline).
@@ -416,9 +416,10 @@ def main():
             print(f"{name}: {', '.join(sorted(needed_steps([name], table))) or '(no run)'}")
         return
     fig = os.path.join(args.runs, "fig")
-    os.makedirs(fig, exist_ok=True)
-    resolved_cases(os.path.join(fig, "resolved_cases.csv"), args.quick)
-    n24_cases(os.path.join(fig, "n24_cases.csv"))
+    if not args.dry_run:  # --dry-run prints the commands and writes nothing
+        os.makedirs(fig, exist_ok=True)
+        resolved_cases(os.path.join(fig, "resolved_cases.csv"), args.quick)
+        n24_cases(os.path.join(fig, "n24_cases.csv"))
     need = needed_steps(names, table) | ({"resolved_n24"} if args.n24 else set())
     start = time.monotonic()
     for step, (output, command, capped) in all_steps.items():

@@ -1,12 +1,14 @@
-"""Numbers of docs/paper-comparison.md, from the tables scripts/make_figures.py writes.
+"""Numbers of docs/studies/paper-comparison.md, from the tables scripts/make_figures.py writes.
 
-Usage: python scripts/paper_comparison.py [--runs runs]
+Usage: python scripts/paper_comparison.py [--runs runs] [--save-n6 data/phase_n6_cases.parquet]
 
 Reads (through ``loopsim.read_results``) the n = 6 grid (runs/phase_n6, the README's
 former main job), the same grid at n = 4 and n = 8, the 24 representative cases with --n auto
 (runs/resolved_auto; runs/resolved_n24 at fixed n = 24 when run with --n24) and the
 seed ensembles (n = 6, --n auto), and prints, per claim of the paper, the measured counts and
-ranges.  Missing tables are skipped with a note.
+ranges.  Missing tables are skipped with a note.  ``--save-n6 FILE`` also writes the n = 6
+grid's case table (without the coefficient column ``x_final``), every column described, the
+table that scripts/render_numbers.py renders the docs' n = 6 counts from.
 """
 import argparse
 import os
@@ -98,9 +100,39 @@ def pairs(low, high, label):
               f"{r['tail_max']:.1e} | {r['wall_s']:.0f} |")
 
 
+def save_cases(frame, path):
+    """Write a sweep's case table to ``path`` (Parquet, without ``x_final``), each column's
+    unit and description in its metadata, with the code version and the sweep's command."""
+    import pyarrow as pa
+
+    from loopsim import columns, storage
+
+    import ast
+    import subprocess
+
+    config = frame.attrs.get("loopsim", {})
+    kept = frame.drop(columns=[c for c in ("x_final",) if c in frame.columns]).reset_index(drop=True)
+    words = config.get("command_line", [])
+    words = ast.literal_eval(words) if isinstance(words, str) else list(words)
+    # no machine's path: the executable and the output directory by name only
+    words = ["loopsim"] + [os.path.basename(w) if os.path.isabs(w) else w for w in words[1:]]
+    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True,
+                            text=True, cwd=os.path.dirname(os.path.abspath(__file__))).stdout.strip()
+    meta = {"loopsim_version": str(config.get("loopsim_version", "")),
+            "code_commit": commit, "command_line": " ".join(words),
+            "created_utc": str(config.get("created_utc_last", ""))}
+    table = pa.Table.from_pandas(kept, preserve_index=False).replace_schema_metadata(meta)
+    declarations = {name: columns.RESULT_COLUMNS[name] for name in kept.columns
+                    if name in columns.RESULT_COLUMNS}
+    declarations["round"] = ("count", "the --seeds auto round of the row (0 for a fixed-seed sweep)")
+    storage.write_table_atomically(storage.described(table, declarations), path)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", default="runs")
+    parser.add_argument("--save-n6", metavar="FILE",
+                        help="also write the n = 6 grid's case table to FILE (Parquet)")
     args = parser.parse_args()
     tables = {name: load(args.runs, name) for name in
               ("phase_n6", "phase_n4", "phase_n8", "resolved_auto", "resolved_n24", "seeds_n6",
@@ -108,6 +140,8 @@ def main():
     for name, frame in tables.items():
         if frame is not None and len(frame):
             describe(name, frame)
+    if args.save_n6 and tables["phase_n6"] is not None:
+        save_cases(tables["phase_n6"], args.save_n6)
     if tables["phase_n6"] is not None and tables["resolved_auto"] is not None:
         pairs(tables["phase_n6"], tables["resolved_auto"], "n = 6 grid against --n auto")
     if tables["resolved_auto"] is not None and tables["resolved_n24"] is not None:

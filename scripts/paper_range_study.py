@@ -1,5 +1,4 @@
-"""The paper's range as probabilities (docs/distributions.md, "The paper's range as
-probabilities").
+"""The paper's range as probabilities (docs/studies/paper-range.md).
 
 Usage: python scripts/paper_range_study.py [--runs runs] [--threads T] [--data data]
                                            [--figure docs/figures/paper_range.png]
@@ -24,7 +23,7 @@ cell checked in distribution against up to 8 seeds at 10x stricter tolerances):
 * ``paper_range_mid66``: g0 = 155.7-228.6 at 66° and 72° (8 cells).
 
 The other 72 cells (g0 > 150 and θ0 >= 24°, except those) are ``--top``'s parts, each
-sample costing seconds to minutes (docs/distributions.md gives the measured costs):
+sample costing seconds to minutes (docs/studies/paper-range.md gives the measured costs):
 
 * ``paper_range_top78``: g0 = 155.7-228.6 at θ0 = 78°, 84° and 90° (12 cells);
 * ``paper_range_top24`` ... ``paper_range_top84``: g0 = 252.9-350 at θ0 = 24° and 30°,

@@ -162,10 +162,10 @@ def test_every_docstring_example_runs_and_does_what_it_says(tmp_path, monkeypatc
 
 
 def test_the_docstrings_state_the_twins_measured_cost():
-    """simulate's and sweep's ``twin`` give the cost docs/auto-and-determinacy.md measures
+    """simulate's and sweep's ``twin`` give the cost docs/studies/n-auto.md measures
     (the twin's RHS evaluations over the run's, median over the README's main job), not
     "about doubles"."""
-    with open(os.path.join(ROOT, "docs", "auto-and-determinacy.md"), encoding="utf-8") as handle:
+    with open(os.path.join(ROOT, "docs", "studies", "n-auto.md"), encoding="utf-8") as handle:
         page = " ".join(handle.read().split())
     twin_over_run = float(re.search(r"([\d.]+) times over the README's main job", page).group(1))
     for function in (loopsim.simulate, loopsim.sweep):

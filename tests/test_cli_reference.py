@@ -179,3 +179,17 @@ def test_summary_figure_help_says_what_the_figure_draws():
                   if "--figure" in a.option_strings)
     assert style.default == "pie" and "pie" in action.help and "P(3D)" not in action.help
 
+
+
+def test_the_rtol_help_carries_the_conditions_of_a_loose_tolerance():
+    """--rtol's help names a looser rtol for tumbling cells; it also says when that holds:
+    distributions only, one tolerance per study, a 16-seed check first (it once gave the
+    cost ratio alone)."""
+    parser = cli.build_parser()
+    for name in ("run", "sweep"):
+        command = subcommands(parser)[name]
+        (action,) = [a for a in command._actions if "--rtol" in a.option_strings]
+        text = " ".join(action.help.split())
+        for condition in ("only for distributions", "one tolerance", "16 seeds at both",
+                          "run's own tilt"):
+            assert condition in text, (name, condition)

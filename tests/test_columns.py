@@ -52,3 +52,17 @@ def test_summary_declarations_cover_every_cell_input_and_regime():
     assert set(outcome_statistics.CELL_INPUTS) <= set(columns.SUMMARY_COLUMNS)
     for regime in outcomes.REGIMES:
         assert f"p_{regime.replace('-', '_')}_high" in columns.SUMMARY_COLUMNS
+
+
+@pytest.mark.parametrize("words, code, text", [
+    (["--help"], 0, "which table"),
+    (["trajectory"], 0, "| `t` |"),
+    (["nonsense"], 2, "invalid choice: 'nonsense'"),
+])
+def test_the_module_prints_a_table_or_one_clear_error(words, code, text):
+    """``python -m loopsim.columns --help`` once ended in a KeyError traceback."""
+    done = subprocess.run([sys.executable, "-m", "loopsim.columns", *words],
+                          capture_output=True, text=True, cwd=ROOT)
+    assert done.returncode == code, done.stderr
+    assert text in done.stdout + done.stderr
+    assert "Traceback" not in done.stderr

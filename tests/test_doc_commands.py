@@ -6,6 +6,7 @@ runs: the default, ``--n auto``, runs that grid's every case up the ladder with 
 ``scripts/make_figures.py`` runs into ``runs/phase_n6`` (same configuration fingerprint),
 so a directory made by hand is one the figure script resumes, not one it refuses."""
 import argparse
+import glob
 import importlib.util
 import json
 import os
@@ -27,9 +28,9 @@ PLACEHOLDER = re.compile(r"^[A-Z][A-Z0-9_]*(?:\.[A-Za-z]+)?$")
 
 
 def doc_texts():
-    """{name: text} of README.md and every docs/*.md page."""
-    names = ["README.md"] + [os.path.join("docs", n) for n in sorted(os.listdir(DOCS))
-                             if n.endswith(".md")]
+    """{name: text} of README.md and every page under docs/ (docs/studies/ included)."""
+    names = ["README.md"] + sorted(os.path.relpath(path, ROOT) for path in glob.glob(
+        os.path.join(DOCS, "**", "*.md"), recursive=True))
     texts = {}
     for name in names:
         with open(os.path.join(ROOT, name), encoding="utf-8") as handle:
@@ -208,12 +209,12 @@ def test_the_checks_catch_what_they_are_for():
 
 
 def test_the_compilation_table_names_what_its_run_runs():
-    """docs/performance.md times ``loopsim run`` commands: each row names the integrator
+    """docs/studies/performance.md times ``loopsim run`` commands: each row names the integrator
     the command runs (it once said "rkf45 at n = 6" for a run that is --n auto, radau5)."""
     from loopsim import refinement
     from loopsim.diagnostics import stability_parameter
 
-    with open(os.path.join(DOCS, "performance.md"), encoding="utf-8") as handle:
+    with open(os.path.join(DOCS, "studies", "performance.md"), encoding="utf-8") as handle:
         section = handle.read().split("## Compilation", 1)[1].split("\n## ", 1)[0]
     rows = [line for line in section.splitlines() if line.startswith("| `loopsim run ")]
     assert rows

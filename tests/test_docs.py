@@ -79,8 +79,10 @@ TABLE_RULE = re.compile(r"^\s*\|?\s*:?-{3,}:?\s*(?:\|\s*:?-{3,}:?\s*)*\|?\s*$")
 
 
 def pages():
-    """Every Markdown page of docs/, by file name."""
-    return sorted(name for name in os.listdir(DOCS) if name.endswith(".md"))
+    """Every Markdown page under docs/ (the study reports of docs/studies/ included), by
+    its path relative to docs/."""
+    return sorted(os.path.relpath(os.path.join(folder, name), DOCS)
+                  for folder, _, names in os.walk(DOCS) for name in names if name.endswith(".md"))
 
 
 def page_text(name):
@@ -212,19 +214,19 @@ FACTS = {
     # the resolved reference's orders and resolved rows
     "the resolved reference's n_used and resolved counts": (
         r"n_used:? \d+ \(\d+ cases?\)|\d+ of (?:the|its) 20 (?:rows|cases) are `resolved`"
-        r"|\d+ rows are `resolved`", "figures.md"),
+        r"|\d+ rows are `resolved`", os.path.join("studies", "figure-runs.md")),
     # the n --n auto chooses for each regime
     "--n auto's n per regime": (
         r"stable loops (?:are resolved|need) at n = \d|in-plane loops need n = \d"
-        r"|\| stable \(q0 below 8\.9001\) \| \d", "README.md"),
+        r"|\| stable \(q0 below 8\.9001\) \| \d", os.path.join("studies", "n-auto.md")),
     # what the twin costs
     "the twin's cost": (
         r"halves the cost|about doubles|twin adds|2\.0[–-]3\.5|case costs [\d.–-]+ times"
         r"|twin costs [\d.]+[–-][\d.]+ times",
-        "auto-and-determinacy.md"),
+        os.path.join("studies", "n-auto.md")),
     # how far a 1e-6 change of the start moves the terminal tilt
     "a changed start's effect on the tilt": (
-        r"(?:start|perturb)[^.]{0,80}?by up to \d+°", "auto-and-determinacy.md"),
+        r"(?:start|perturb)[^.]{0,80}?by up to \d+°", os.path.join("studies", "n-auto.md")),
 }
 
 

@@ -35,7 +35,9 @@ def with_option(words, option, value):
 def test_readme_opens_with_the_install_the_main_job_and_the_tests():
     commands = readme_commands()
     assert len(commands) == 2
-    assert all(c.startswith("pip install -e '.[test]' && ") for c in commands)
+    # the main job installs the package alone: it needs none of the test extra
+    assert commands[0].startswith("pip install -e . && ")
+    assert commands[1].startswith("pip install -e '.[test]' && ")
     assert "loopsim sweep" in commands[0] and "--figure" in main_command()
     assert commands[1].endswith("python -m pytest -q")
     with open(os.path.join(ROOT, ".ci", "run"), encoding="utf-8") as handle:
@@ -57,3 +59,36 @@ def test_main_command_runs_on_a_fresh_directory(tmp_path):
     assert len(frame) == 2 and frame["resolved"].all() and frame["determined"].all()
     assert set(frame["regime"]) == {"stable"}
     assert "2 cases in" in done.stdout
+
+
+def readme_text():
+    with open(os.path.join(ROOT, "README.md"), encoding="utf-8") as handle:
+        return handle.read()
+
+
+def test_readme_is_a_front_door():
+    """At most 100 lines; the output's column table one link away; the settings for the
+    top of the range linked; no study history (it lives in docs/studies/ and CHANGELOG.md)."""
+    text = readme_text()
+    assert text.count("\n") <= 100
+    assert "](docs/sweeps.md#table-columns)" in text
+    assert "docs/choosing-n-method-rtol.md#above-g0--250" in text
+    assert re.search(r"^\| above g0 ≈ 250", text, re.M)  # the regime table's row for high q
+
+
+def test_the_main_job_needs_no_test_extra():
+    """What the main job imports is in the package's own dependencies, not only in the
+    test extra (pytest, hypothesis, duckdb, mkdocs)."""
+    import tomllib
+
+    with open(os.path.join(ROOT, "pyproject.toml"), "rb") as handle:
+        project = tomllib.load(handle)["project"]
+    extra_only = {re.split(r"[<>=\[]", r)[0] for r in project["optional-dependencies"]["test"]}
+    extra_only -= {re.split(r"[<>=\[]", r)[0] for r in project["dependencies"]}
+    probe = ("import sys, loopsim.cli, loopsim.sweeps, loopsim.figures, loopsim.storage; "
+             "print(' '.join(sorted(m.split('.')[0] for m in sys.modules)))")
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                          cwd=ROOT, timeout=300)
+    assert done.returncode == 0, done.stderr
+    imported = set(done.stdout.split())
+    assert not imported & {name.replace("-", "_") for name in extra_only}

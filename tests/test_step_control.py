@@ -126,7 +126,7 @@ def test_the_newton_limit_ignores_rates_measured_in_the_noise():
     assert converged and rate >= 0 and limit_rate == -1.0
 
 
-#: Compiled unit costs in RHS evaluations at n = 32 on an idle machine (docs/performance.md:
+#: Compiled unit costs in RHS evaluations at n = 32 on an idle machine (docs/studies/performance.md:
 #: F 0.11 ms, J 3.7 ms, the LU pair 1.5 ms), to weigh counts into one cost.
 J_IN_F, LU_PAIR_IN_F = 34, 14
 

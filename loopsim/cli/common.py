@@ -86,10 +86,13 @@ def add_integration_options(parser):
     parser.add_argument("--t-end", type=real, default=DEFAULT_T_END, metavar="T",
                         help=f"final time, in t_u ({UNITS})")
     parser.add_argument("--rtol", type=real, default=DEFAULT_RTOL, metavar="RTOL",
-                        help="relative tolerance of the time integration (dimensionless); "
-                        "where loops tumble only the distribution over seeds means anything, "
-                        "and 1e-3 gave the same one as 1e-6 (16 seeds) for 0.72-0.77x the "
-                        "cost of a tumbling sample (docs/choosing-n-method-rtol.md)")
+                        help="relative tolerance of the time integration (dimensionless); keep "
+                        "the default for a run's own tilt. Where loops tumble only the "
+                        "distribution over seeds means anything, and there 1e-3 (with --atol "
+                        "1e-6) gave the same distribution as 1e-6 for less cost: use it only "
+                        "for distributions, with every cell of a study at one tolerance, after "
+                        "a check of 16 seeds at both tolerances compared with loopsim compare "
+                        "(docs/choosing-n-method-rtol.md, 'Above g0 ~ 250')")
     parser.add_argument("--atol", type=real, default=DEFAULT_ATOL, metavar="ATOL",
                         help="absolute tolerance of the time integration, on the shape "
                         "coefficients, in L/2pi")

@@ -1,0 +1,307 @@
+"""Fill the measured numbers of README.md and docs/ from the committed tables.
+
+Usage: python scripts/render_numbers.py [--check]
+
+A number a page quotes from a study is written between two markers,
+``<!-- num:KEY -->value<!-- /num -->``; ``KEY`` names a function of :data:`NUMBERS`
+that computes the value from a committed table under ``data/`` (never from a run made
+now).  The script rewrites every marked value in README.md and docs/**/*.md from those
+functions; the rest of the pages is prose, kept as it is.  ``--check`` writes nothing and
+exits 1, naming each span, if a page differs from its table or names a key that does not
+exist (tests/test_render_numbers.py runs it).
+
+The tables:
+
+* ``data/phase_n6_cases.parquet``: the n = 6 grid (``loopsim sweep --g0 10:350:15
+  --theta0 6:90:15 --n 6 --method rkf45 --no-twin``), one row per case, written by
+  ``python scripts/paper_comparison.py --save-n6``.  Its rows are not resolved, so its
+  counts move with rounding (another machine or BLAS may move a few cases between
+  regimes); the table is the run on the commit its metadata names.
+* ``data/seeds_auto_grid_summary.parquet``: the main job's 72 points at ``--seeds auto``.
+* ``data/paper_range_runs/paper_range_top24``: the runs of g0 = 252.9-350 at 24-30 deg.
+* ``data/convergence_top.parquet`` and ``data/convergence_runs``: the convergence study at
+  the top of the range.
+"""
+import argparse
+import functools
+import glob
+import os
+import re
+import sys
+
+import numpy as np
+import pandas as pd
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+DATA = os.path.join(ROOT, "data")
+#: A marked number: its key and its value as the page states it.
+SPAN = re.compile(r"<!-- num:([\w.\-]+) -->(.*?)<!-- /num -->", re.S)
+#: The circle's in-plane threshold (docs/stability.md): a terminal q below it ends circular.
+Q_STAR = 8.9001
+#: What paper-comparison calls a near-horizontal circle.
+FLAT_TILT_DEG, ROUND_ASPECT = 15.0, 1.05
+#: The paper's grid above g0 = 250 at 24-90 deg: 5 values of g0 (252.9-350) x 12 of theta0.
+TOP_CELLS = 5 * 12
+
+
+# ---------------------------------------------------------------------------------
+# The tables, read once.
+
+@functools.lru_cache(maxsize=None)
+def table(name):
+    """A committed table of data/ (a Parquet file, or a sweep directory through
+    ``loopsim.read_results``)."""
+    path = os.path.join(DATA, name)
+    if os.path.isdir(path):
+        import loopsim
+
+        return loopsim.read_results(path)
+    return pd.read_parquet(path)
+
+
+def n6():
+    return table("phase_n6_cases.parquet")
+
+
+def n6_regime(regime):
+    frame = n6()
+    return frame[frame["regime"] == regime]
+
+
+def grid():
+    return table("seeds_auto_grid_summary.parquet")
+
+
+def top24_first_round():
+    frame = table(os.path.join("paper_range_runs", "paper_range_top24"))
+    return frame[frame["round"] == 0]
+
+
+def convergence():
+    return table("convergence_top.parquet")
+
+
+# ---------------------------------------------------------------------------------
+# Formats.
+
+def count(value):
+    """An integer with a thin space every three digits, as the pages write them."""
+    return f"{int(value):,}".replace(",", " ")
+
+
+def fixed(digits):
+    return lambda value: f"{value:.{digits}f}"
+
+
+def quartiles(values, digits):
+    return " / ".join(f"{v:.{digits}f}" for v in np.quantile(values, [0.25, 0.5, 0.75]))
+
+
+def span(values, digits):
+    """"a–b", from the smallest to the largest value."""
+    return f"{np.min(values):.{digits}f}–{np.max(values):.{digits}f}"
+
+
+def per_case_cost(regime_column):
+    """Seconds of wall time per case at the main job's points whose every seed ended in
+    one regime (``wall_s`` over ``seeds``), median and largest."""
+    frame = grid()
+    points = frame[frame[regime_column] == 1]
+    return points["wall_s"] / points["seeds"]
+
+
+def seconds(value):
+    return f"{value:.2g} s" if value < 1 else f"{value:.0f} s" if value >= 10 else f"{value:.1f} s"
+
+
+# ---------------------------------------------------------------------------------
+# The numbers, by key: each a function of the tables, returning the text a page shows.
+
+def _n6_counts():
+    frame, d3 = n6(), n6_regime("3d")
+    flat = d3["theta_final_deg"] < FLAT_TILT_DEG
+    low = frame[frame["q_final"] < Q_STAR]
+    inplane = n6_regime("in-plane")
+    band = frame[(frame["q0"] > 10.5) & (frame["q0"] < 18.5)]
+    nonstable = frame[frame["regime"] != "stable"]
+    return {
+        "n6.cases": count(len(frame)),
+        "n6.3d": count(len(d3)),
+        "n6.in-plane": count(len(inplane)),
+        "n6.stable": count(len(n6_regime("stable"))),
+        "n6.unresolved": count((~frame["resolved"]).sum()),
+        "n6.unresolved-3d": count((~d3["resolved"]).sum()),
+        "n6.unresolved-in-plane": count((~inplane["resolved"]).sum()),
+        "n6.unresolved-stable": count((~n6_regime("stable")["resolved"]).sum()),
+        "n6.resolved": count(frame["resolved"].sum()),
+        "n6.3d-less-tilted": count((d3["theta_final_deg"] < d3["theta0_deg"]).sum()),
+        "n6.3d-less-tilted-percent": f"{100 * (d3['theta_final_deg'] < d3['theta0_deg']).mean():.0f} %",
+        "n6.3d-flat": count(flat.sum()),
+        "n6.3d-circles": count((flat & (d3["aspect_ratio"] < ROUND_ASPECT)).sum()),
+        "n6.3d-circles-percent": f"{100 * (flat & (d3['aspect_ratio'] < ROUND_ASPECT)).mean():.0f} %",
+        "n6.3d-tilt-quartiles": quartiles(d3["theta_final_deg"], 1),
+        "n6.3d-aspect-quartiles": quartiles(d3["aspect_ratio"], 2),
+        "n6.3d-q-final-span": f"{d3['q_final'].min():.1f} to {d3['q_final'].max():.0f}",
+        "n6.steady": count((frame["stop_reason"] == "steady").sum()),
+        "n6.moving": count((frame["stop_reason"] == "t_end").sum()),
+        "n6.moving-3d": count((d3["stop_reason"] == "t_end").sum()),
+        "n6.low-q": count(len(low)),
+        "n6.low-q-circles": count((low["aspect_ratio"] <= 1.01).sum()),
+        "n6.low-q-others": count((low["aspect_ratio"] > 1.01).sum()),
+        "n6.low-q-others-steady": count(((low["aspect_ratio"] > 1.01)
+                                         & (low["stop_reason"] == "steady")).sum()),
+        "n6.3d-length-error-median": f"{d3['length_error_max'].median():.3f}",
+        "n6.3d-length-error-max": f"{d3['length_error_max'].max():.2f}",
+        "n6.settling-max-stable": f"{n6_regime('stable')['settling_angle_deg'].max():.4f}°",
+        "n6.settling-max-in-plane": f"{inplane['settling_angle_deg'].max():.2f}°",
+        "n6.settling-max-3d": f"{d3['settling_angle_deg'].max():.2f}°",
+        "n6.largest-stable-q0": f"{n6_regime('stable')['q0'].max():.2f}",
+        "n6.smallest-nonstable-q0": f"{nonstable['q0'].min():.2f}",
+        "n6.smallest-3d-q0": f"{d3['q0'].min():.2f}",
+        "n6.in-plane-q0-span": span(inplane["q0"], 2),
+        "n6.band-cases": count(len(band)),
+        "n6.band-3d": count((band["regime"] == "3d").sum()),
+        "n6.band-in-plane": count((band["regime"] == "in-plane").sum()),
+    }
+
+
+def _n6_labels():
+    """How the regime thresholds (1 deg of tilt, 0.01 of aspect ratio) cut the n = 6 grid."""
+    frame = n6()
+    tilt = (frame["theta_final_deg"] - frame["theta0_deg"]).abs()
+    aspect = (frame["aspect_ratio"] - frame["aspect_ratio_initial"]).abs()
+    small, middle = frame[tilt < 0.1], frame[(tilt >= 0.1) & (tilt <= 1)]
+    continuum = frame[(tilt > 1) & (tilt <= 5)]
+    return {
+        "n6.tilt-below-0.1": count(len(small)),
+        "n6.tilt-below-0.1-stable": count((small["regime"] == "stable").sum()),
+        "n6.tilt-below-0.1-in-plane": count((small["regime"] == "in-plane").sum()),
+        "n6.tilt-0.1-to-1": count(len(middle)),
+        "n6.tilt-0.1-to-1-regimes": ", ".join(sorted(set(middle["regime"]))),
+        "n6.tilt-0.1-to-1-q0": span(middle["q0"], 1),
+        "n6.tilt-1-to-5": count(len(continuum)),
+        "n6.tilt-above-10": count((tilt > 10).sum()),
+        "n6.aspect-within-0.01": count((aspect <= 0.01).sum()),
+        "n6.aspect-above-0.2": count((aspect > 0.2).sum()),
+        "n6.stable-length-error-max": f"{n6_regime('stable')['length_error_max'].max():.1e}",
+    }
+
+
+def _grid_costs():
+    return {
+        "grid.cost-stable": seconds(per_case_cost("p_stable").median()),
+        "grid.cost-in-plane": seconds(per_case_cost("p_in_plane").median()),
+        "grid.cost-3d": seconds(per_case_cost("p_3d").median()),
+        "grid.cost-3d-max": seconds(per_case_cost("p_3d").max()),
+    }
+
+
+def _top_costs():
+    runs = top24_first_round()
+    return {
+        "top.runs": count(len(runs)),
+        "top.sample-median": seconds(runs["wall_s"].median()),
+        "top.sample-span": f"{runs['wall_s'].min():.1f}–{runs['wall_s'].max():.0f} s",
+        "top.n-used": "–".join(str(int(v)) for v in sorted({runs["n_used"].min(), runs["n_used"].max()})),
+        "top.twin-over-run": f"{runs['twin_nfev'].sum() / runs['nfev'].sum():.2f}×",
+        "top.unsteady": count((runs["terminal_state"] == "unsteady").sum()),
+        # the 60 cells of g0 >= 252.9 at 24-90 deg, 8 seeds each, at the median sample
+        "top.cells60-seeds8-hours": f"{TOP_CELLS * 8 * runs['wall_s'].median() / 3600:.0f} h",
+        "top.cells60-seeds8-hours-twins": f"{TOP_CELLS * 8 * runs['wall_s'].median() * (1 + runs['twin_nfev'].sum() / runs['nfev'].sum()) / 3600:.0f} h",
+    }
+
+
+def _tumbling_samples():
+    """What a sample costs at (350, 18 deg) on the current radau5 (the convergence study's
+    ``jmid_t18``: the defaults with the Jacobian inside the step), 16 seeds to t = 10."""
+    runs = table(os.path.join("convergence_runs", "jmid_t18"))
+    cell = runs[(runs["g0"].round(1) == 350) & (runs["theta0_deg"] == 18)]
+    return {
+        "conv.tumbling-350-seeds": count(len(cell)),
+        "conv.tumbling-350-median": seconds(cell["wall_s"].median()),
+        "conv.tumbling-350-max": seconds(cell["wall_s"].max()),
+    }
+
+
+def _convergence():
+    frame = convergence()
+    loose = frame[frame["setting"] == "jmid_rtol1e-3"]
+    probabilities = loose[[c for c in frame.columns if c.startswith("delta_p_")
+                           and c.endswith("_detectable")]].to_numpy()
+    return {
+        "conv.rtol1e-3-detectable-p": span(probabilities[np.isfinite(probabilities)], 2),
+        "conv.rtol1e-3-detectable-tilt": " and ".join(
+            f"{v:.1f}°" for v in sorted(loose["delta_tilt_q50_detectable"])),
+        "conv.rtol1e-3-verdicts": ", ".join(sorted(set(loose["verdict"]))),
+        "conv.rtol1e-3-cells": " and ".join(
+            f"({g:g}, {t:g}°)" for g, t in sorted(zip(loose["g0"].round(1), loose["theta0_deg"]))),
+    }
+
+
+#: Groups of keys, each computed together from one table; a key's function is its group's.
+GROUPS = (_n6_counts, _n6_labels, _grid_costs, _top_costs, _tumbling_samples, _convergence)
+
+
+@functools.lru_cache(maxsize=None)
+def numbers():
+    """{key: the value's text} for every key of every group."""
+    values = {}
+    for group in GROUPS:
+        values.update(group())
+    return values
+
+
+# ---------------------------------------------------------------------------------
+# The pages.
+
+def pages():
+    """README.md and every Markdown page under docs/, as paths relative to the root."""
+    names = ["README.md"] + sorted(
+        os.path.relpath(p, ROOT) for p in glob.glob(os.path.join(ROOT, "docs", "**", "*.md"),
+                                                      recursive=True))
+    return names
+
+
+def rendered(text, values):
+    """(the text with every marked value replaced from ``values``, [problems])."""
+    problems = []
+
+    def fill(match):
+        key, shown = match.group(1), match.group(2)
+        if key not in values:
+            problems.append(f"{key}: no such number")
+            return match.group(0)
+        if shown != values[key]:
+            problems.append(f"{key}: the page says {shown!r}, the table {values[key]!r}")
+        return f"<!-- num:{key} -->{values[key]}<!-- /num -->"
+
+    return SPAN.sub(fill, text), problems
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--check", action="store_true",
+                        help="write nothing; exit 1 if a page differs from its table")
+    args = parser.parse_args(argv)
+    values, stale, unknown = numbers(), [], []
+    for name in pages():
+        path = os.path.join(ROOT, name)
+        with open(path, encoding="utf-8") as handle:
+            text = handle.read()
+        new, problems = rendered(text, values)
+        unknown += [f"{name}: {p}" for p in problems if p.endswith("no such number")]
+        if new != text:
+            stale += [f"{name}: {p}" for p in problems if not p.endswith("no such number")]
+            if not args.check:
+                with open(path, "w", encoding="utf-8") as handle:
+                    handle.write(new)
+    for line in unknown:
+        print(line, file=sys.stderr)
+    if args.check and stale:
+        print("\n".join(stale) + "\nrun python scripts/render_numbers.py", file=sys.stderr)
+        return 1
+    return 1 if unknown else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

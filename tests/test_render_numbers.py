@@ -1,0 +1,65 @@
+"""The measured numbers the pages quote are the committed tables' (scripts/render_numbers.py):
+every marked span of README.md and docs/ equals what its function computes from data/, a
+page that disagrees or names no such number fails, and the numbers are where the pages
+need them (the n = 6 grid's counts, the settings at the top of the range)."""
+import importlib.util
+import os
+import re
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+
+
+def render_numbers():
+    spec = importlib.util.spec_from_file_location(
+        "render_numbers", os.path.join(ROOT, "scripts", "render_numbers.py"))
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+RENDER = render_numbers()
+
+
+def page(name):
+    with open(os.path.join(ROOT, name), encoding="utf-8") as handle:
+        return handle.read()
+
+
+def test_every_marked_number_is_its_tables():
+    values = RENDER.numbers()
+    problems = {name: RENDER.rendered(page(name), values)[1] for name in RENDER.pages()}
+    problems = {name: found for name, found in problems.items() if found}
+    assert not problems, f"{problems}: run python scripts/render_numbers.py"
+
+
+def test_the_check_exits_1_on_a_stale_page_and_names_the_span():
+    values = {"n6.3d": "172"}
+    text = "3D <!-- num:n6.3d -->171<!-- /num --> and <!-- num:nothing -->1<!-- /num -->"
+    new, problems = RENDER.rendered(text, values)
+    assert new == "3D <!-- num:n6.3d -->172<!-- /num --> and <!-- num:nothing -->1<!-- /num -->"
+    assert problems == ["n6.3d: the page says '171', the table '172'", "nothing: no such number"]
+
+
+def test_the_n6_counts_are_the_committed_tables():
+    """Independently of the script: the regime counts of data/phase_n6_cases.parquet, as the
+    settings guide states them."""
+    import pandas as pd
+
+    frame = pd.read_parquet(os.path.join(ROOT, "data", "phase_n6_cases.parquet"))
+    counts = frame["regime"].value_counts()
+    text = page(os.path.join("docs", "choosing-n-method-rtol.md"))
+    for key, regime in (("n6.3d", "3d"), ("n6.in-plane", "in-plane"), ("n6.stable", "stable")):
+        shown = re.search(rf"<!-- num:{re.escape(key)} -->(\d+)<!-- /num -->", text).group(1)
+        assert int(shown) == counts[regime], key
+    assert len(frame) == 225 and set(frame["n"]) == {6} and set(frame["method"]) == {"rkf45"}
+    assert "move with rounding" in text
+
+
+def test_the_pages_mark_what_they_quote_from_the_tables():
+    """The numbers that drifted from their tables are marked, so the check covers them."""
+    keys = {name: set(re.findall(r"<!-- num:([\w.\-]+) -->", page(name))) for name in RENDER.pages()}
+    assert {"n6.3d", "n6.in-plane", "n6.unresolved"} <= keys[os.path.join("docs", "choosing-n-method-rtol.md")]
+    assert {"top.sample-median", "top.n-used"} <= keys[os.path.join("docs", "choosing-n-method-rtol.md")]
+    assert {"n6.3d-tilt-quartiles", "n6.steady", "n6.3d-circles"} <= keys[
+        os.path.join("docs", "studies", "paper-comparison.md")]
+    assert {"grid.cost-stable", "top.sample-median"} <= keys["README.md"]
