@@ -131,6 +131,35 @@ def _figures(frame, cells, seeds_auto):
             f"<img alt='{html.escape(title)}' src='{png_data_uri(fig)}'>")
 
 
+#: The settling columns of the report's per-cell settling table (``loopsim.survival``).
+SETTLING_SHOWN = ("at_rest", "rest_observed", "p_rest_t10", "p_rest_t10_low", "p_rest_t10_high",
+                  "t_rest_median", "t_rest_median_low", "t_rest_median_high", "t_rest_q95",
+                  "escape_events", "escape_rate", "escape_rate_low", "escape_rate_high")
+#: The survival curves are drawn for at most this many cells (one curve each).
+SURVIVAL_CELLS_MAX = 10
+
+
+def _settling(frame, cells):
+    """The settling section: per cell, how many came to rest, P(at rest by t = 10), the
+    median settling time and the escape rate (``loopsim.survival``), and the survival
+    curves for a few cells; empty where the rows were not tested for rest."""
+    from . import figures
+
+    if "at_rest" not in cells:
+        return ""
+    inputs = [c for c in cells.columns if c in ("g0", "theta0_deg", "t_end")]
+    parts = ["<h2>Settling</h2><p>A loop comes to rest when it passes the steady test "
+             "(stop_reason steady; its settling time is t_final); one still moving at its "
+             "t_end is censored there. P(at rest by the paper's horizon t = 10) and the "
+             "median settling time are Kaplan–Meier estimates with 95 % intervals; NaN: "
+             "not reached within the runs (docs/sweeps.md).</p>",
+             table_html(cells, inputs + [c for c in SETTLING_SHOWN if c in cells], "settling")]
+    if len(cells) <= SURVIVAL_CELLS_MAX:
+        fig = figures.survival_curves(frame)
+        parts.append(f"<img alt='survival of not yet at rest' src='{png_data_uri(fig)}'>")
+    return "".join(parts)
+
+
 def _failed(frame, sweep_dir):
     from . import outcome_statistics
 
@@ -179,6 +208,7 @@ def report_html(sweep_dir, seed=0, costliest=COSTLIEST):
         _provenance(meta, sweep_dir),
         _counts(outcome_statistics.outcome_counts(frame), stopped),
         _figures(frame, cells, seeds_auto),
+        _settling(frame, cells),
         _failed(frame, sweep_dir),
         _cost(frame, costliest),
         f"<h2>Per cell</h2><p>One row per cell (<code>loopsim summary {html.escape(sweep_dir)}"

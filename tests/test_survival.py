@@ -124,3 +124,33 @@ def test_summarize_adds_the_settling_columns_only_where_rows_were_tested():
     frame.attrs["loopsim"] = {"sweep_config": {"early_stop": False}}
     untested = outcome_statistics.summarize(frame)
     assert "p_rest_t10" not in untested or untested["p_rest_t10"].isna().all()
+
+
+def test_survival_figure_and_report_section():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from loopsim import figures, sweep_report
+    from loopsim.stability.rest_window import RestWindow, StabilityLoss
+
+    frame = pd.concat([
+        cell([4.8, 5.5, 16.4, 40.0], ["steady", "steady", "steady", "t_end"], g0=350.0,
+             tilts=[15.0, 12.0, 3.0, 60.0]),
+        cell([3.0, 9.0, 10.0], ["steady", "steady", "t_end"], g0=325.7)], ignore_index=True)
+    fig = figures.survival_curves(frame)
+    ax = fig.axes[0]
+    labels = [text.get_text() for text in ax.get_legend().get_texts()]
+    assert labels == ["g0 = 325.7, θ0 = 18° (2 of 3 at rest)",
+                      "g0 = 350, θ0 = 18° (3 of 4 at rest)"]
+    # the 350 curve ends at the censored run's S = 1/4 (three of four came to rest)
+    steps = [line for line in ax.get_lines() if line.get_label().startswith("g0 = 350")][0]
+    assert steps.get_ydata()[-1] == pytest.approx(0.25)
+    window = RestWindow(n=16, w=10.0, q_circle=8.9, losses=(
+        StabilityLoss(q=37.55, kind="hopf", sector="out-of-plane", frequency=22.0),))
+    assert survival.window_counts(frame[frame.g0 == 350.0], window) == dict(
+        rest_inside=2, rest_below=1, rest_outside=0)
+    figures.rest_tilts(frame, window)
+    cells = outcome_statistics.summarize(frame, rest_window=window)
+    assert list(cells["rest_inside"]) == [2, 2] and list(cells["rest_below"]) == [0, 1]
+    html = sweep_report._settling(frame, cells)
+    assert "<h2>Settling</h2>" in html and "data:image/png" in html

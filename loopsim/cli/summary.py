@@ -46,7 +46,8 @@ def command(args):
     shown = [c for c in table.columns if c in outcome_statistics.CELL_INPUTS] + [
         c for c in ("seeds", "determined", "steady") if c in table] + [
         "p_stable", "p_in_plane", "p_3d", "p_3d_low", "p_3d_high",
-        "tilt_median", "tilt_median_low", "tilt_median_high"]
+        "tilt_median", "tilt_median_low", "tilt_median_high"] + [
+        c for c in ("at_rest", "p_rest_t10", "t_rest_median") if c in table]
     print_and_write(table, args.out, dict(table.attrs["loopsim_summary"],
                                            summary_of=directory_name(args.sweep_dir),
                                            perturbation_ensemble=PERTURBATION_ENSEMBLE),

@@ -27,6 +27,8 @@ as DataFrames, so every function can be drawn from stored numbers:
   table (``loopsim.summarize``) drawn as distributions;
 * :func:`growth_rates`, :func:`nonlocal_thresholds`, :func:`model_outcomes` - the
   linearisation of the circle, the nonlocal model beside the local one;
+* :func:`survival_curves`, :func:`rest_tilts` - how long loops take to come to rest
+  (Kaplan–Meier) and where they rest against the stable branch's tilt window;
 * :func:`trajectory` - one run's snapshots, face-on, with tilt and aspect ratio;
 * :func:`save` - write a figure atomically;
 * :func:`animate` - a GIF or MP4 of one run (``loopsim animate``, module ``animation``);
@@ -34,7 +36,7 @@ as DataFrames, so every function can be drawn from stored numbers:
 
 The modules: ``style`` (shared helpers and styles, :func:`save`), ``gallery`` (Fig. 4),
 ``evolution`` (Figs. 6 and 1, a run's trajectory), ``terminal`` (Figs. 7, 8, seeds),
-``phase`` (Figs. 5, 9), ``linear`` (Fig. 3, the steady branch), ``nonlocal_sbt`` (the
+``phase`` (Figs. 5, 9), ``settling`` (settling times, rest window), ``linear`` (Fig. 3, the steady branch), ``nonlocal_sbt`` (the
 nonlocal model), ``distributions`` (summary tables over seeds), ``suite`` (files to PNGs).
 Regime colours are :data:`REGIME_STYLE` (the paper's: stable dark purple,
 in-plane green-blue, 3D yellow); cases not resolved at their n are hollow.
@@ -55,6 +57,7 @@ from .gallery import gallery, plane_view, side_view_basis, unit_circle
 from .linear import branch_lines, growth_rates, load_branch, stability, stability_data
 from .nonlocal_sbt import model_outcomes, nonlocal_thresholds
 from .phase import phase_diagram, phase_diagrams
+from .settling import rest_tilts, survival_curves
 from .style import (
     ASPECT_LABEL, CURVE_POINTS, PAPER_BAND, REGIME_STYLE, TIME_CMAP, centred_curve, coefficients,
     default_thresholds, frame_model, mark_undetermined, merged_legend_entries, model_text,
@@ -75,7 +78,8 @@ __all__ = [
     "mark_undetermined", "merged_legend_entries", "model_outcomes", "model_text", "new_figure",
     "nonlocal_thresholds", "order_column", "orders_text", "phase_diagram", "phase_diagrams",
     "plane_view", "probability_phase_diagram", "q_and_tilt", "q_lines", "read_run", "read_sweep",
-    "regime_key", "regime_pies", "regime_style", "resolved_mask", "run_title", "save", "save_distribution_figure",
+    "regime_key", "regime_pies", "regime_style", "resolved_mask", "rest_tilts", "run_title", "save",
+    "save_distribution_figure", "survival_curves",
     "scatter_regimes", "seed_distributions", "settling_index", "side_view_basis", "single_axes",
     "snapshot_indices", "stability", "stability_data", "sweep_kind", "sweep_label",
     "tension_figure", "tension_on_shape", "tilt_distribution", "time_colours", "trajectory",

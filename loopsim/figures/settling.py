@@ -1,0 +1,81 @@
+"""How long loops take to come to rest, and where they rest: the Kaplan–Meier survival of
+"not yet at rest" per cell (``loopsim.survival``), and terminal tilts against the stable
+branch's tilt window (``loopsim.stability.rest_window``)."""
+import numpy as np
+
+from .. import survival
+from .style import single_axes
+
+#: Line colours of successive cells (matplotlib's tab10 order).
+CELL_COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown",
+                "tab:pink", "tab:gray", "tab:olive", "tab:cyan")
+
+
+def _cell_label(g0, theta0):
+    return f"g0 = {g0:.4g}, θ0 = {theta0:.4g}°"
+
+
+def survival_curves(frame, ax=None, horizon=survival.PAPER_HORIZON):
+    """S(t), the share of a cell's loops not yet at rest at time t (Kaplan–Meier, with its
+    95 % log-log band shaded), one step curve per (g0, θ0) cell of a results table, a
+    tick at each run still moving at its t_end (censored), and the paper's horizon
+    t = 10 dashed.  Returns the figure."""
+    fig, ax = single_axes(ax, (6.0, 4.0))
+    t_last = float(frame["t_final"].max()) if len(frame) else horizon
+    cells = frame.groupby(["g0", "theta0_deg"], sort=True)
+    for colour, ((g0, theta0), rows) in zip(CELL_COLOURS * 10, cells):
+        times, at_rest = survival.settling_times(rows)
+        curve = survival.survival_curve(times, at_rest)
+        if len(curve):
+            t = np.append(curve["t"].to_numpy(float), times.max())
+            sf = np.append(curve["sf"].to_numpy(float), curve["sf"].iloc[-1])
+            low = np.append(curve["sf_low"].to_numpy(float), curve["sf_low"].iloc[-1])
+            high = np.append(curve["sf_high"].to_numpy(float), curve["sf_high"].iloc[-1])
+        else:   # none came to rest: S = 1 up to the longest run
+            t, sf = np.array([0.0, times.max() if times.size else 0.0]), np.ones(2)
+            low = high = sf
+        label = f"{_cell_label(g0, theta0)} ({int(at_rest.sum())} of {times.size} at rest)"
+        ax.step(t, sf, where="post", color=colour, label=label)
+        ax.fill_between(t, low, high, step="post", color=colour, alpha=0.15, linewidth=0)
+        censored = times[~at_rest]
+        if censored.size:
+            ax.plot(censored, [sf[np.searchsorted(t, c, side="right") - 1] for c in censored],
+                    "|", color=colour, markersize=10, markeredgewidth=1.5)
+    ax.axvline(horizon, color="0.4", linestyle="--", linewidth=1)
+    ax.text(horizon, 0.02, " the paper's horizon", color="0.4", fontsize=8, va="bottom")
+    ax.set(xlabel="t (t_u)", ylabel="not yet at rest, S(t)", ylim=(0.0, 1.08),
+           xlim=(0.0, max(t_last, horizon) * 1.02))
+    ax.legend(fontsize=7, loc="upper right", frameon=True, framealpha=0.9)
+    ax.set_title("Kaplan–Meier survival of “not yet at rest” (95 % band; | still moving at t_end)",
+                 fontsize=9)
+    return fig
+
+
+def rest_tilts(frame, window, ax=None):
+    """Terminal tilts of the loops that came to rest, per cell (x: cell, y: tilt), over the
+    stable branch's tilt window at each cell's g0 (shaded; below it loops rest as tilted
+    circles); loops still moving at their t_end as open markers.  ``window``: a
+    ``loopsim.stability.rest_window.RestWindow``.  Returns the figure."""
+    cells = list(frame.groupby(["g0", "theta0_deg"], sort=True))
+    fig, ax = single_axes(ax, (max(4.0, 1.2 * len(cells) + 2.0), 4.0))
+    for i, ((g0, theta0), rows) in enumerate(cells):
+        low, high = window.tilts(g0)
+        ax.fill_between([i - 0.4, i + 0.4], low if low == low else 0.0, high, color="tab:green",
+                        alpha=0.2, linewidth=0, label="stable branch" if i == 0 else None)
+        ax.plot([i - 0.4, i + 0.4], [theta0, theta0], color="0.3", linewidth=1,
+                label="initial tilt θ0" if i == 0 else None)
+        rested = rows["stop_reason"].eq("steady")
+        jitter = np.linspace(-0.25, 0.25, max(1, len(rows)))[: len(rows)]
+        ax.plot(i + jitter[rested.to_numpy()], rows.loc[rested, "theta_final_deg"], "o",
+                color="tab:blue", markersize=4, label="at rest" if i == 0 else None)
+        moving = rows["stop_reason"].eq("t_end")
+        ax.plot(i + jitter[moving.to_numpy()], rows.loc[moving, "theta_final_deg"], "o",
+                mfc="none", color="tab:red", markersize=4,
+                label="still moving at t_end" if i == 0 else None)
+    ax.set_xticks(range(len(cells)), [_cell_label(g, t).replace(", ", "\n") for (g, t), _ in cells],
+                  fontsize=7)
+    ax.set(ylabel="terminal tilt (deg)", ylim=(0.0, 90.0))
+    ax.legend(fontsize=7, frameon=False, loc="upper left")
+    ax.set_title(f"where loops rest: the stable branch's tilt window\n(q = g0 sin θ / 3 from "
+                 f"{window.q_circle:.4f} to the first loss, {window.q_loss:.4f})", fontsize=9)
+    return fig
