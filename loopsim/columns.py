@@ -311,6 +311,51 @@ CASE_COLUMNS = ("g0", "theta0_deg", "n", "seed", "perturbation", "initial",
                 "initial_case_id") + CASE_OVERRIDES
 
 
+#: name: (unit, description) of every column of the run-to-rest study
+#: (``scripts/rest_study.py``, ``data/rest_study.parquet``): one row per cell, its seeds
+#: run until they come to rest or reach t_max; the ``delta_*`` columns compare the cell
+#: at rest with a t = 10 sample of it (column ``baseline``; empty where none exists).
+REST_STUDY_COLUMNS = {
+    "g0": RESULT_COLUMNS["g0"],
+    "theta0_deg": RESULT_COLUMNS["theta0_deg"],
+    "q0": RESULT_COLUMNS["q0"],
+    "sweep": (TEXT, "the sweep directory of the cell's runs (data/rest_runs; the code it ran "
+                    "on: STUDY_COMMITS.json there)"),
+    "t_max": (TIME, "the runs' t_end: a loop not at rest by then is censored there"),
+    "window_low_deg": (DEG, "lower edge of the stable branch's tilt window at g0 (q = "
+                            "8.9001; below it loops rest as tilted circles)"),
+    "window_high_deg": (DEG, "upper edge of the window (the first loss of stability along "
+                             "the branch, the out-of-plane Hopf point q = 37.5532)"),
+    "seeds": SUMMARY_COLUMNS["seeds"],
+    "failed": (COUNT, "of them, runs that failed"),
+    "moving_at_t_max": (COUNT, "runs still moving at t_max (censored)"),
+    **{name: SUMMARY_COLUMNS[name] for name in (
+        "rest_observed", "at_rest", "rest_inside", "rest_below", "rest_outside",
+        "p_rest_t10", "p_rest_t10_low", "p_rest_t10_high", "t_rest_median",
+        "t_rest_median_low", "t_rest_median_high", "t_rest_q95", "escape_events",
+        "tail_time", "escape_rate", "escape_rate_low", "escape_rate_high",
+        "p_stable", "p_in_plane", "p_3d", "tilt_q25", "tilt_median", "tilt_q75",
+        "tilt_median_low", "tilt_median_high")},
+    "nfev_mean": CONVERGENCE_COLUMNS["nfev_mean"],
+    "wall_s": CONVERGENCE_COLUMNS["wall_s"],
+    "baseline": (TEXT, "the t = 10 sweep of the same cell compared with (16 seeds at the "
+                       "defaults, data/convergence_runs), or empty"),
+    "base_seeds": (COUNT, "seeds of the t = 10 sample"),
+    "base_p_steady": (PROBABILITY, "share of the t = 10 sample at rest by t = 10"),
+    "base_p_3d": (PROBABILITY, "share of the t = 10 sample ending 3D"),
+    "base_tilt_median": (DEG, "median terminal tilt of the t = 10 sample"),
+    **{k: (unit, what.replace("this setting's minus its baseline's", "at rest minus at t = 10"))
+       for k, (unit, what) in {
+           **_difference_columns("p_in_plane", PROBABILITY, "P(in-plane)"),
+           **_difference_columns("p_3d", PROBABILITY, "P(3D)"),
+           **{k: v for q in (25, 50, 75)
+              for k, v in _difference_columns(f"tilt_q{q}", DEG, f"terminal tilt quantile {q}%")
+              .items()}}.items()},
+    "verdict": (TEXT, "different (a Bonferroni interval excludes 0) or same (within the "
+                      "intervals), at rest against t = 10; empty where no t = 10 sample"),
+}
+
+
 def field_metadata(name, table=RESULT_COLUMNS):
     """Parquet field metadata of a column: {b"unit": ..., b"description": ...}."""
     unit, description = table[name]
@@ -330,7 +375,7 @@ def markdown(table=RESULT_COLUMNS):
 #: The tables ``python -m loopsim.columns [NAME]`` prints.
 TABLES = {"results": RESULT_COLUMNS, "trajectory": TRAJECTORY_COLUMNS,
           "summary": SUMMARY_COLUMNS, "compare": COMPARE_COLUMNS, "stops": STOP_COLUMNS,
-          "convergence": CONVERGENCE_COLUMNS}
+          "convergence": CONVERGENCE_COLUMNS, "rest": REST_STUDY_COLUMNS}
 
 def main(argv=None):
     """``python -m loopsim.columns [NAME]``: print a column table as Markdown."""

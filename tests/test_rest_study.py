@@ -1,0 +1,56 @@
+"""scripts/rest_study.py: its table from finished sweeps (here the convergence study's
+t = 10 sweeps standing in for run-to-rest ones), its declared columns, and its refusal to
+shrink a committed table."""
+import os
+import shutil
+import subprocess
+import sys
+
+import pandas as pd
+import pyarrow.parquet as pq
+import pytest
+
+from loopsim import columns
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SCRIPT = os.path.join(ROOT, "scripts", "rest_study.py")
+
+
+def run_study(tmp_path, out):
+    return subprocess.run([sys.executable, SCRIPT, "--read-only", "--runs", str(tmp_path / "runs"),
+                           "--out", str(out), "--figures", str(tmp_path), "--window-n", "8"],
+                          capture_output=True, text=True, cwd=ROOT)
+
+
+@pytest.fixture
+def runs(tmp_path):
+    shutil.copytree(os.path.join(ROOT, "data", "convergence_runs", "jmid_t18"),
+                    tmp_path / "runs" / "rest_t18_350")
+    return tmp_path
+
+
+def test_table_from_finished_sweeps(runs):
+    out = runs / "rest.parquet"
+    done = run_study(runs, out)
+    assert done.returncode == 0, done.stderr
+    table = pd.read_parquet(out)
+    assert list(table.columns) == [c for c in columns.REST_STUDY_COLUMNS if c in table]
+    fields = pq.read_schema(out)
+    assert all(fields.field(c).metadata for c in table.columns)     # declared, with units
+    row = table.iloc[0]
+    frame = pd.read_parquet(runs / "runs" / "rest_t18_350")
+    assert row["seeds"] == len(frame) == 16
+    assert row["at_rest"] == frame["stop_reason"].eq("steady").sum()
+    assert row["at_rest"] == row["rest_inside"] + row["rest_below"] + row["rest_outside"]
+    # the sweep compared with itself (its own t = 10 sample): no difference at all
+    assert row["delta_p_3d"] == 0 and row["verdict"] == "same"
+    assert (runs / "rest_survival.png").stat().st_size > 0
+
+
+def test_refuses_to_shrink_a_table(runs):
+    out = runs / "rest.parquet"
+    bigger = pd.DataFrame(dict(g0=[350.0, 325.7], theta0_deg=[18.0, 18.0]))
+    bigger.to_parquet(out)
+    done = run_study(runs, out)
+    assert done.returncode == 2 and "holds 2 cells, this run only 1" in done.stderr
+    assert len(pd.read_parquet(out)) == 2
