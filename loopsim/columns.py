@@ -198,8 +198,9 @@ STOP_COLUMNS = {
     "seeds": (COUNT, "seeds run for the cell"),
     "rounds": (COUNT, "rounds the cell took part in"),
     "stop_reason": (TEXT, "why the cell stopped: failed (every seed failed: no distribution, "
-                          "no check), deterministic, sharp or cap (--max-seeds reached) "
-                          "(loopsim.seeding)"),
+                          "no check), deterministic, sharp or cap (--max-seeds reached), or "
+                          "rescued (--rerun-failed replaced failed runs since: intervals "
+                          "wider than the targets) (loopsim.seeds_auto_rule)"),
     "p_halfwidth": (PROBABILITY, "largest half-width of the regime shares' 95% Wilson "
                                  "intervals at the stop"),
     "tilt_halfwidth_deg": (DEG, "half-width of the median terminal tilt's 95% bootstrap "
