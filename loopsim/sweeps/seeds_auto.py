@@ -4,8 +4,8 @@ The directory (``storage.seedsdir``) holds the cells, the targets and the sweep'
 options, one ordinary sweep directory per round (checksummed, resumable) and, once every
 cell has stopped, the stop table: one row per cell saying why it stopped
 (``seeds_auto_rule``: failed, deterministic, sharp or cap; rescued where a later
-``--rerun-failed`` replaced failed runs: :func:`restate_stop_table`).  Round r's cases are planned from the rows of
-rounds < r only, by ``seeds_auto_rule.decide``; those rows are reproducible bit for bit, so
+``--rerun-failed`` replaced failed runs: :func:`restate_stop_table`).  Round r's cases
+are planned from the rows of rounds < r only, by ``seeds_auto_rule.decide``; those rows are reproducible bit for bit, so
 re-running the command after an interruption plans the same rounds and resumes the one
 it stopped in.  Each round's configuration fingerprint is recorded in the directory's
 record before the round runs, so that a round copied in from elsewhere is refused on
