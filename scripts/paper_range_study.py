@@ -265,7 +265,9 @@ def shrinking(args, cells):
         if lost:
             what = (f"{path!r}" if option == "--data"
                     else f"the figure {args.figure!r} (it draws {path!r})")
-            return (f"the finished parts in {args.runs!r} cover {len(have) - len(lost)} of "
+            parts = ("the finished parts" if args.read_only
+                     else "the parts finished or to run")
+            return (f"{parts} in {args.runs!r} cover {len(have) - len(lost)} of "
                     f"the {len(have)} cells of {what}: writing would drop {len(lost)} cells; "
                     "finish the other parts, or give --data and --figure other places (a "
                     "partial run never replaces a fuller table)")
