@@ -100,6 +100,9 @@ RESULT_COLUMNS = {
                                "more than tilt_change_deg (1 deg) from its terminal value "
                                "(t_final - t0 if never): how long the final tilt has held"),
     "stop_reason": (TEXT, "t_end | steady (terminal state reached early) | the failure"),
+    "early_stop": (FLAG, "whether the run was tested for a steady state, so that "
+                         "stop_reason steady could end it (False: --no-early-stop; rows "
+                         "written before it existed: the sweep's setting)"),
     "aspect_ratio_initial": (ONE, "aspect ratio of the start"),
     "length_error_max": (ONE, "largest |relative length error| along the trajectory"),
     "x_final": (LENGTH, "terminal shape coefficients, row-major (3, 2 n_used + 1): "
@@ -226,8 +229,9 @@ STOP_COLUMNS = {
     "seeds": (COUNT, "seeds run for the cell"),
     "rounds": (COUNT, "rounds the cell took part in"),
     "stop_reason": (TEXT, "why the cell stopped: failed (every seed failed: no distribution, "
-                          "no check), deterministic, sharp or cap (--max-seeds reached) "
-                          "(loopsim.seeding)"),
+                          "no check), deterministic, sharp or cap (--max-seeds reached), or "
+                          "rescued (--rerun-failed replaced failed runs since: intervals "
+                          "wider than the targets) (loopsim.seeds_auto_rule)"),
     "p_halfwidth": (PROBABILITY, "largest half-width of the regime shares' 95% Wilson "
                                  "intervals at the stop"),
     "tilt_halfwidth_deg": (DEG, "half-width of the median terminal tilt's 95% bootstrap "

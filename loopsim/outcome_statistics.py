@@ -9,8 +9,8 @@ two rows with one seed in one cell differ in an input the table does not record 
 
 * ``seeds``, ``resolved``, ``determined``, ``steady``: how many rows, and how many of
   them are resolved and determined (``loopsim.outcomes``) and reached a steady state
-  before ``t_end`` (unknown, ``<NA>``, where the sweep ran without the early stop:
-  ``steady_tested``);
+  before ``t_end`` (unknown, ``<NA>``, where a row ran without the early stop:
+  ``rows_tested``);
 * ``p_<regime>`` for each regime, with its 95 % Wilson score interval
   ``p_<regime>_low``, ``p_<regime>_high``:
 
@@ -109,17 +109,31 @@ def steady_tested(frame):
     return not (isinstance(config, dict) and config.get("early_stop") is False)
 
 
-def _cell_row(rows, seed, tested=True, window=None):
+def rows_tested(rows, tested=True):
+    """Whether every row of ``rows`` was tested for a steady state: its ``early_stop``
+    (False: run with ``--no-early-stop``), or where a row does not record it (null, or no
+    such column: a table read by other means than ``read_results``) ``tested``, the
+    table's own (:func:`steady_tested`)."""
+    if "early_stop" not in rows:
+        return tested
+    return bool(rows["early_stop"].astype(object).where(rows["early_stop"].notna(), tested)
+                .astype(bool).all())
+
+
+def _cell_row(rows, seed, tested=True, motion=True, window=None):
     trials = len(rows)
     out = dict(seeds=trials, resolved=int(rows["resolved"].sum()),
                determined=int(rows["determined"].eq(True).sum()))
-    if "stop_reason" in rows:
-        out["steady"] = int(rows["stop_reason"].eq("steady").sum()) if tested else pd.NA
-    if "terminal_state" in rows and rows["terminal_state"].notna().all():
+    if "stop_reason" in rows:  # unknown (<NA>) where a row was never tested
+        out["steady"] = (int(rows["stop_reason"].eq("steady").sum())
+                         if rows_tested(rows, tested) else pd.NA)
+    if motion:  # unknown (<NA>, NaN) where a row of the cell does not record it
+        recorded = rows["terminal_state"].notna().all()
         unsteady = int(rows["terminal_state"].eq("unsteady").sum())
-        out["unsteady"] = unsteady
-        out["p_unsteady"] = unsteady / trials
-        out["p_unsteady_low"], out["p_unsteady_high"] = wilson_interval(unsteady, trials)
+        out["unsteady"] = unsteady if recorded else pd.NA
+        out["p_unsteady"] = unsteady / trials if recorded else float("nan")
+        out["p_unsteady_low"], out["p_unsteady_high"] = (
+            wilson_interval(unsteady, trials) if recorded else (float("nan"),) * 2)
     for regime in REGIMES:
         name = regime.replace("-", "_")
         hits = int((rows["regime"] == regime).sum())
@@ -134,7 +148,7 @@ def _cell_row(rows, seed, tested=True, window=None):
         out[f"{short}_q25"], out[f"{short}_median"], out[f"{short}_q75"] = map(float, quartiles)
         out[f"{short}_median_low"], out[f"{short}_median_high"] = bootstrap_interval(
             finite, seed=seed)
-    if tested and "stop_reason" in rows and "t_final" in rows:
+    if "stop_reason" in rows and "t_final" in rows and rows_tested(rows, tested):
         out.update(survival.settling_statistics(rows))
         if window is not None:
             out.update(survival.window_counts(rows, window))
@@ -177,11 +191,12 @@ def summarize(frame, by=None, seed=0, rest_window=None):
           many of them are resolved, determined, and reached a steady state before
           ``t_end`` (the others ran to ``t_end``, their "terminal" values the state
           there, or failed; ``steady`` only where ``frame`` has ``stop_reason``, and
-          unknown, ``<NA>``, where its sweep ran with ``--no-early-stop``:
-          ``steady_tested``);
+          unknown, ``<NA>``, in a cell where a row ran with ``--no-early-stop``: its
+          ``early_stop`` False, or where rows do not record it, ``steady_tested``);
         * ``unsteady`` and ``p_unsteady`` (with its Wilson interval): the rows still
           moving at their end (``terminal_state``, ``loopsim.late_motion``), only where
-          every row of ``frame`` records it;
+          some row of ``frame`` records it, and unknown (``<NA>``, NaN), never 0, in a
+          cell where some row does not (rows written by an older release);
         * ``p_<regime>`` for each regime (stable, in_plane, 3d, failed), with its 95 %
           Wilson score interval ``p_<regime>_low``, ``p_<regime>_high``:
           (p̂ + z²/2N ± z sqrt(p̂(1 − p̂)/N + z²/4N²)) / (1 + z²/N), z = Φ⁻¹(0.975);
@@ -220,10 +235,13 @@ def summarize(frame, by=None, seed=0, rest_window=None):
     if not len(frame):
         raise ValueError("no rows to summarise")
     tested = steady_tested(frame)
-    rows = [dict(zip(by, key), **_cell_row(group, seed, tested, rest_window))
+    motion = "terminal_state" in frame and bool(frame["terminal_state"].notna().any())
+    rows = [dict(zip(by, key), **_cell_row(group, seed, tested, motion, rest_window))
             for key, group in cell_groups(frame, by)]
     table = pd.DataFrame(rows)
-    if "steady" in table and not tested:
+    if motion and table["unsteady"].isna().any():
+        table["unsteady"] = table["unsteady"].astype("Int64")  # unknown: <NA>
+    if "steady" in table and table["steady"].isna().any():
         table["steady"] = table["steady"].astype("Int64")  # unknown: <NA>, empty in Parquet
     table.attrs["loopsim_summary"] = dict(cells_by=by, bootstrap_seed=seed,
                                           bootstrap_resamples=BOOTSTRAP_RESAMPLES,
@@ -244,22 +262,52 @@ def _regime_counts(rows):
     return {str(k): int(v) for k, v in sorted(rows["regime"].value_counts().items())}
 
 
+def not_recorded(frame, column):
+    """How many rows of ``frame`` do not record ``column`` (a null value, or no such
+    column: rows written by a release before the column existed, filled in by
+    ``storage.read_results`` as null)."""
+    return len(frame) if column not in frame else int(frame[column].isna().sum())
+
+
 def outcome_counts(frame):
     """The counts of a results table (``read_results``) that ``loopsim sweep`` closes
     with: ``cases``; ``regimes`` ({regime: rows}); ``unresolved`` (rows not resolved at
     their n), ``undetermined`` (rows whose twin ends elsewhere) and ``unsteady`` (rows
     still moving at their end, ``terminal_state``), each with the regimes among them
     (``unresolved_regimes``, ``undetermined_regimes``, ``unsteady_regimes``); ``failed``
-    (rows whose ``status`` is not "ok")."""
+    (rows whose ``status`` is not "ok").
+
+    ``unsteady`` is None (unknown, never 0) where some row does not record
+    ``terminal_state`` (written by an older release): ``unsteady_not_recorded`` says how
+    many, and ``unsteady_recorded`` counts the unsteady rows among those that do (with
+    ``unsteady_regimes``)."""
     unresolved = frame[~frame["resolved"].astype(bool)]
     undetermined = frame[frame["determined"].eq(False)]
     unsteady = (frame[frame["terminal_state"].eq("unsteady")] if "terminal_state" in frame
                 else frame.iloc[:0])
+    missing = not_recorded(frame, "terminal_state")
     return dict(cases=len(frame), regimes=_regime_counts(frame), unresolved=len(unresolved),
                 unresolved_regimes=_regime_counts(unresolved), undetermined=len(undetermined),
-                undetermined_regimes=_regime_counts(undetermined), unsteady=len(unsteady),
-                unsteady_regimes=_regime_counts(unsteady),
+                undetermined_regimes=_regime_counts(undetermined),
+                unsteady=None if missing else len(unsteady), unsteady_recorded=len(unsteady),
+                unsteady_not_recorded=missing, unsteady_regimes=_regime_counts(unsteady),
                 failed=int((frame["status"] != "ok").sum()))
+
+
+def unsteady_text(counts):
+    """The count of rows still moving at their end as a reader should see it (from
+    :func:`outcome_counts`): "2 (regimes among them: 3d 2)", or where rows do not record
+    ``terminal_state``, "not recorded ..." with how many and the count among the rest."""
+    regimes = ", ".join(f"{k} {v}" for k, v in counts["unsteady_regimes"].items()) or "none"
+    if counts["unsteady"] is not None:
+        return f"{counts['unsteady']} (regimes among them: {regimes})"
+    missing, cases = counts["unsteady_not_recorded"], counts["cases"]
+    text = (f"not recorded (unknown) for {missing} of {cases} cases: their rows have no "
+            "terminal_state (written by a release before it existed)")
+    if missing < cases:
+        text += (f"; {counts['unsteady_recorded']} of the {cases - missing} that record it "
+                 f"(regimes among them: {regimes})")
+    return text
 
 
 def stop_counts(stops):

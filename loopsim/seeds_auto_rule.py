@@ -13,6 +13,10 @@ seeds and doubles them, round after round, until one of these holds, checked in 
   at most ``tilt_halfwidth_deg``;
 * ``cap``: the cell has ``max_seeds`` seeds.
 
+After the sweep, ``--rerun-failed`` may replace failed runs: the cells it touched are
+decided again from their rows, and one the rule would give more seeds stops as
+``rescued`` (the finished sweep adds none).
+
 A cell whose runs are *samples* (``runs_are_samples``: some run succeeded, and its
 seeds end in different regimes, or some run's stricter twin ends elsewhere) needs no more
 twins: each would only prove once more that one run is a sample.  Its later seeds run
@@ -36,6 +40,10 @@ from .outcome_statistics import bootstrap_interval, wilson_interval
 
 #: Why a cell stopped adding seeds (``stop_reason``); ``CONTINUE`` while it has not.
 FAILED, DETERMINISTIC, SHARP, CAP, CONTINUE = "failed", "deterministic", "sharp", "cap", ""
+#: The stop reason of a cell of a finished sweep whose failed runs ``--rerun-failed``
+#: replaced since, where the rule would now add seeds (``sweeps.seeds_auto``,
+#: ``restate_stop_table``): its intervals are wider than the targets.
+RESCUED = "rescued"
 
 
 @dataclasses.dataclass(frozen=True)

@@ -95,6 +95,8 @@ def _provenance(meta, sweep_dir):
 
 
 def _counts(counts, stopped):
+    from . import outcome_statistics
+
     items = [("cases", counts["cases"]), ("by regime", _counts_text(counts["regimes"])),
              ("not resolved at their n", f"{counts['unresolved']} (regimes among them: "
               f"{_counts_text(counts['unresolved_regimes'])})"),
@@ -102,8 +104,7 @@ def _counts(counts, stopped):
              ("not determined (a twin ends elsewhere)", f"{counts['undetermined']} (regimes "
               f"among them: {_counts_text(counts['undetermined_regimes'])})"),
              ("still moving at their end (terminal_state unsteady)",
-              f"{counts['unsteady']} (regimes among them: "
-              f"{_counts_text(counts['unsteady_regimes'])})"),
+              outcome_statistics.unsteady_text(counts)),
              ("failed", counts["failed"])]
     if stopped is not None:
         items.append(("points, why their seeds stopped", f"{stopped['points']}: "

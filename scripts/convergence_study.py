@@ -41,10 +41,20 @@ compares every setting with its baseline (BASELINE: the defaults on the same cod
 ``loopsim.distribution_differences``: differences of the regime probabilities, of
 P(steady before t_end) and of the tilt quartiles, with 95 % intervals, the smallest
 difference each comparison could have detected, and a verdict.
+
+Before any sweep runs, ``--out`` must be a file that can be written (not a directory; its
+folder writable or makeable) and, unless ``--read-only``, ``--loopsim`` an executable:
+otherwise one line and exit status 2.  A partial run never shrinks the table: where the
+finished sweeps would give fewer rows (cell and setting) than the table already at
+``--out`` (the committed ``data/convergence_top.parquet``, say, from a ``--runs`` folder
+holding some of the sweeps), the script refuses in one line, naming the rows it would
+lose, with exit status 2 and nothing written; give ``--out`` another place to tabulate
+a partial run.  It does not merge: the rows would come from different runs.
 """
 import argparse
 import json
 import os
+import shutil
 import subprocess
 import sys
 
@@ -109,6 +119,8 @@ def cell_rows(frame):
     out = frame.assign(**{f"is_{r.replace('-', '_')}": frame["regime"].eq(r) for r in REGIMES})
     out["steady"] = frame["stop_reason"].eq("steady").astype("boolean")
     out.loc[frame["stop_reason"].isna(), "steady"] = pd.NA
+    if "early_stop" in frame:  # a run never tested for a steady state: unknown
+        out.loc[frame["early_stop"].eq(False).fillna(False).astype(bool), "steady"] = pd.NA
     out["unsteady"] = frame["terminal_state"].eq("unsteady").astype("boolean")
     out.loc[frame["terminal_state"].isna(), "unsteady"] = pd.NA  # written before it existed
     return out
@@ -158,6 +170,55 @@ def tabulate(frames):
     return pd.DataFrame(table).sort_values(["theta0_deg", "g0", "setting"], ignore_index=True)
 
 
+def fail(message):
+    """One line on stderr and exit status 2 (bad input: nothing was run or written)."""
+    print(f"convergence_study: error: {message}", file=sys.stderr)
+    sys.exit(2)
+
+
+def check_places(args):
+    """One-line refusals of an ``--out`` that cannot be written and (unless
+    ``--read-only``) a ``--loopsim`` that is not an executable, before any work."""
+    from loopsim import validation
+
+    try:
+        validation.check_output_file("--out", args.out)
+    except ValueError as exc:
+        fail(exc)
+    if not args.read_only and shutil.which(args.loopsim) is None:
+        fail(f"--loopsim {args.loopsim!r} is not an executable (give the loopsim that runs "
+             "the sweeps, or --read-only to tabulate the finished ones)")
+
+
+def row_keys(frame):
+    """The (g0, θ0, setting) rows of a convergence table, rounded past the last bit."""
+    return {(round(float(g), 9), round(float(t), 9), str(s))
+            for g, t, s in zip(frame["g0"], frame["theta0_deg"], frame["setting"])}
+
+
+def sweep_keys(setting, g0, theta0):
+    """The rows a sweep of ``setting`` over ``g0`` (comma-separated) at ``theta0`` gives."""
+    return {(round(float(g), 9), round(float(theta0), 9), setting) for g in g0.split(",")}
+
+
+def refuse_if_shrinking(out, keys, runs):
+    """Exit (one line, status 2) where the table at ``out`` holds rows that ``keys`` lacks:
+    a partial run never replaces a fuller table."""
+    if not os.path.isfile(out):
+        return
+    try:
+        have = row_keys(pd.read_parquet(out, columns=["g0", "theta0_deg", "setting"]))
+    except Exception as exc:  # noqa: BLE001 - an unreadable table is kept as it is
+        fail(f"{out!r} cannot be read to compare its rows ({exc}): nothing written over it; "
+             "give --out another place")
+    lost = have - keys
+    if lost:
+        fail(f"the finished sweeps in {runs!r} give {len(have) - len(lost)} of the "
+             f"{len(have)} rows (cell and setting) of {out!r}: writing would drop "
+             f"{len(lost)}; finish the other sweeps, or give --out another place (a partial "
+             "run never replaces a fuller table)")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", default=os.path.join("runs", "convergence"))
@@ -168,6 +229,11 @@ def main():
     parser.add_argument("--read-only", action="store_true",
                         help="run nothing: tabulate the sweeps that have finished")
     args = parser.parse_args()
+    check_places(args)
+    if not args.read_only:  # every sweep runs: the rows all of them give
+        refuse_if_shrinking(args.out, set().union(*(sweep_keys(setting, g0, theta0) for
+                                                    _, setting, g0, theta0 in SWEEPS)),
+                            args.runs)
     frames, finished = {}, []
     for name, setting, g0, theta0 in SWEEPS:
         path = os.path.join(args.runs, name)
@@ -189,6 +255,9 @@ def main():
         frames[setting] = pd.concat([frames.get(setting), cell_rows(frame)], ignore_index=True)
     if not frames:
         sys.exit("convergence_study: no sweep has finished")
+    refuse_if_shrinking(args.out, set().union(*(
+        row_keys(frame.assign(setting=setting)) for setting, frame in frames.items())),
+        args.runs)
     table = tabulate(frames)
     meta = dict(ensemble=ENSEMBLE, seeds=f"0-{SEEDS - 1}", sweeps=finished,
                 settings={k: " ".join(v) for k, v in SETTINGS.items()}, baselines=BASELINE,

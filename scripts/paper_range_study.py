@@ -50,6 +50,16 @@ where none has).
 writes in one folder of its own, ``runs/paper_range_quick/`` by default (its sweeps, both
 tables and the figure), and refuses to write over the committed study's tables and figure
 (exit status 2).
+
+A partial run never shrinks a table: where the finished parts (with ``--read-only``; or
+those finished and those to run) would cover fewer cells than a table already at the
+place it would write (the committed 153-cell ``data/paper_range_summary.parquet``, say,
+from a ``--runs`` folder holding one finished part), or than the committed table its
+figure draws, the script refuses in one line, naming the table and the cells it would
+lose, with exit status 2 and nothing written (checked before any sweep runs, and again
+before writing).  It does not merge a partial run into a fuller table either: their
+rows would come from different sweeps.  To tabulate a partial run, give ``--data`` and
+``--figure`` other places; to replace a table on purpose, move it away first.
 """
 import argparse
 import os
@@ -199,6 +209,78 @@ def resolve_outputs(args):
     return args
 
 
+def cell_keys(frame):
+    """The cells (g0, θ0) of a table or of a part's grid, as a set of rounded pairs (the
+    values are the grid's own, :data:`G0`, :data:`THETA0`: rounding only spares them
+    the last bit)."""
+    return {(round(float(g), 9), round(float(t), 9))
+            for g, t in zip(frame["g0"], frame["theta0_deg"])}
+
+
+def expected_cells(args, parts, to_run):
+    """The cells the tables will cover: those of the finished parts' stop tables, and
+    (unless ``--read-only``) the grids of the unfinished parts that run."""
+    cells = set()
+    for name, g0, theta0 in parts:
+        path = os.path.join(args.runs, name)
+        if os.path.isfile(os.path.join(path, storage.STOPS_FILE)):
+            cells |= cell_keys(storage.read_stop_table(path))
+        elif not args.read_only and name in to_run:
+            cells |= {(round(float(g), 9), round(float(t), 9)) for g in g0 for t in theta0}
+    return cells
+
+
+def committed_figure_table(args):
+    """The committed summary table that the figure ``args.figure`` draws, where the
+    figure is one of the study's committed figures (in the repository or the working
+    directory), else None."""
+    if not args.figure:
+        return None
+    for base in (ROOT, os.getcwd()):
+        for figure, table in (("paper_range.png", SUMMARY_FILE),
+                              ("paper_range_top.png", TOP_SUMMARY_FILE)):
+            path = os.path.join(base, "docs", "figures", figure)
+            if os.path.realpath(args.figure) == os.path.realpath(path):
+                return os.path.join(base, "data", table)
+    return None
+
+
+def shrinking(args, cells):
+    """The one-line refusal where writing tables and the figure of ``cells`` would shrink
+    a table: one already at ``--data`` (the summary or the stops table), or the committed
+    table the figure draws, holding cells that ``cells`` lacks; None where none would."""
+    places = [(os.path.join(args.data, args.summary_file), "--data"),
+              (os.path.join(args.data, args.stops_file), "--data"),
+              (committed_figure_table(args), "--figure")]
+    for path, option in places:
+        if path is None or not os.path.isfile(path):
+            continue
+        try:
+            have = cell_keys(pd.read_parquet(path, columns=["g0", "theta0_deg"]))
+        except Exception as exc:  # noqa: BLE001 - any unreadable table is kept as it is
+            return (f"{path!r} cannot be read to compare its cells ({exc}): nothing written "
+                    f"over it; give {option} another place")
+        lost = have - cells
+        if lost:
+            what = (f"{path!r}" if option == "--data"
+                    else f"the figure {args.figure!r} (it draws {path!r})")
+            parts = ("the finished parts" if args.read_only
+                     else "the parts finished or to run")
+            return (f"{parts} in {args.runs!r} cover {len(have) - len(lost)} of "
+                    f"the {len(have)} cells of {what}: writing would drop {len(lost)} cells; "
+                    "finish the other parts, or give --data and --figure other places (a "
+                    "partial run never replaces a fuller table)")
+    return None
+
+
+def refuse_if_shrinking(args, cells):
+    """Exit with status 2 and one line on stderr where :func:`shrinking` refuses."""
+    refusal = shrinking(args, cells)
+    if refusal is not None:
+        print(f"paper_range_study: error: {refusal}", file=sys.stderr)
+        sys.exit(2)
+
+
 def steady_lines(table):
     """The printout's lines on the cells with seeds not steady at ``t_end`` (their tilt a
     snapshot), from a summary table; cells whose ``steady`` is unknown (``<NA>``: run with
@@ -224,6 +306,9 @@ def main():
     except ValueError as exc:
         print(f"paper_range_study: error: {exc}", file=sys.stderr)
         sys.exit(2)
+    expected = expected_cells(args, parts, to_run)
+    if expected:  # (none: "no part has finished" below says it better)
+        refuse_if_shrinking(args, expected)  # before any sweep runs
     frames, stops, checks = [], [], []
     for name, g0, theta0 in parts:
         path = os.path.join(args.runs, name)
@@ -245,6 +330,7 @@ def main():
     stop["n"] = stop["n"].astype("int64")
     check_rows = pd.concat(checks, ignore_index=True) if checks else pd.DataFrame()
     table = outcome_statistics.summarize(frame.drop(columns="part"))
+    refuse_if_shrinking(args, cell_keys(table) & cell_keys(stop))  # the cells as run
     os.makedirs(args.data, exist_ok=True)
     meta = dict(summary_of=" + ".join(sorted(set(frame["part"]))))
     shown = ["g0", "theta0_deg", "seeds", "determined", "p_stable", "p_in_plane", "p_3d",

@@ -785,3 +785,40 @@ def test_ctrl_c_with_dask_is_one_line_and_leaves_no_process(tmp_path):
     time.sleep(1.0)
     alive = [c.pid for c in children if c.is_running() and c.status() != psutil.STATUS_ZOMBIE]
     assert alive == [], alive
+
+
+def _as_if_older_release(path, dropped):
+    """Rewrite the result file ``path`` without the columns ``dropped``, as a release
+    before they existed wrote it (its metadata and a fresh content hash kept)."""
+    table = pq.read_table(path)
+    storage.write_table_atomically(
+        table.drop_columns([name for name in dropped if name in table.schema.names]), path)
+
+
+def test_a_resume_across_releases_says_which_columns_older_rows_lack(tmp_path, capsys):
+    """Issue 54.1: rows without terminal_state (an older release) counted as not moving
+    (0 where the sweep run whole today reports its count), and the resume that mixed
+    them with rows that record it said nothing."""
+    from loopsim import outcome_statistics
+
+    sweep = str(tmp_path / "s")
+    command = ["sweep", "--g0", "10,60", "--theta0", "30", "--n", "4", "--t-end", "0.2",
+               "--chunk-size", "1", "--no-twin", "--threads", "1", "--quiet", "--out", sweep]
+    assert main(command) == 0
+    first, second = sorted(storage.chunk_files(sweep).values())
+    _as_if_older_release(first, storage.MOTION_FIELDS + ("early_stop",))
+    os.remove(second)
+    capsys.readouterr()
+    assert main(command) == 0  # the resume: case 1 again, on this release
+    out, err = capsys.readouterr()
+    lines = [line for line in err.splitlines() if "terminal_state" in line]
+    assert len(lines) == 1 and "1 of the 2 rows lack column(s) terminal_state" in lines[0], err
+    assert "still moving at their end (column 'terminal_state'): not recorded (unknown) " \
+           "for 1 of 2 cases" in out
+    frame = loopsim.read_results(sweep)
+    assert frame["terminal_state"].isna().tolist() == [True, False]
+    counts = outcome_statistics.outcome_counts(frame)
+    assert counts["unsteady"] is None and counts["unsteady_not_recorded"] == 1
+    assert frame.get("early_stop", pd.Series()).tolist() == [True, True]  # the sweep's
+    assert main(command) == 0  # nothing to resume: the table still mixes, and says so
+    assert "1 of the 2 rows lack column(s) terminal_state" in capsys.readouterr().err

@@ -262,3 +262,26 @@ def test_summary_figure_of_cells_sharing_a_point_is_refused_before_writing(tmp_p
     assert not table.exists() and not figure.exists()
     assert main(["summary", str(out), "--out", str(table)]) == 0
     assert list(pd.read_parquet(table)["rtol"]) == [1e-7, 1e-6]
+
+
+def test_steady_is_unknown_for_rows_never_tested_however_the_table_was_read(tmp_path, capsys):
+    """Issue 54.7: summarize(pd.concat([early-stop rows, --no-early-stop rows])) counted
+    the untested rows as not steady, and a --no-early-stop chunk read with
+    pd.read_parquet gave steady 0 where the command line gives <NA>: each row now records
+    whether it was tested (``early_stop``)."""
+    grid = ["--theta0", "30", "--seeds", "2", "--n", "4", "--t-end", "0.3", "--no-twin",
+            "--threads", "1", "--quiet"]
+    tested, untested = str(tmp_path / "tested"), str(tmp_path / "untested")
+    assert main(["sweep", "--g0", "10", *grid, "--out", tested]) == 0
+    assert main(["sweep", "--g0", "40", *grid, "--no-early-stop", "--out", untested]) == 0
+    capsys.readouterr()
+    a, b = loopsim.read_results(tested), loopsim.read_results(untested)
+    both = outcome_statistics.summarize(pd.concat([a, b], ignore_index=True))
+    assert both["g0"].tolist() == [10.0, 40.0]
+    assert both["steady"].iloc[0] == int(a["stop_reason"].eq("steady").sum())
+    assert pd.isna(both["steady"].iloc[1])  # never tested: unknown, not 0
+    plain = outcome_statistics.summarize(pd.read_parquet(untested))
+    assert plain.attrs["loopsim_summary"] and pd.isna(plain["steady"].iloc[0])
+    assert main(["summary", untested]) == 0
+    assert pd.isna(outcome_statistics.summarize(b)["steady"].iloc[0])
+    assert a["early_stop"].tolist() == [True, True] and b["early_stop"].tolist() == [False] * 2

@@ -115,3 +115,50 @@ def test_top_keeps_its_sweeps_and_tables_apart(monkeypatch):
                           capture_output=True, text=True, timeout=300, cwd=ROOT)
     err = done.stderr.strip().splitlines()
     assert done.returncode == 2 and len(err) == 1 and "paper_range_low" in err[0], done.stderr
+
+
+def _checkout_with_one_finished_part(tmp_path):
+    """A checkout's committed tables and figure (copies: the test cannot damage the
+    repository's own) and a --runs folder holding one finished part (the committed
+    paper_range_top78 sweep under a main part's name, paper_range_mid30)."""
+    work = tmp_path / "checkout"
+    for path in COMMITTED:
+        copy = work / os.path.relpath(path, ROOT)
+        os.makedirs(copy.parent, exist_ok=True)
+        shutil.copy(path, copy)
+    runs = tmp_path / "R"
+    shutil.copytree(os.path.join(ROOT, "data", "paper_range_runs", "paper_range_top78"),
+                    runs / "paper_range_mid30")
+    return work, runs, [str(work / os.path.relpath(p, ROOT)) for p in COMMITTED]
+
+
+@pytest.mark.parametrize("given", [["--read-only"], ["--read-only", "--parts", "paper_range_mid30"],
+                                   ["--read-only", "--data", "elsewhere"]])
+def test_a_partial_run_never_shrinks_the_committed_tables(tmp_path, given):
+    """Issue 54.2: --read-only --runs R (or --parts) with one finished part in R exited 0
+    and rewrote data/paper_range_summary.parquet (153 cells down to the part's), the stops
+    table and docs/figures/paper_range.png.  Now one line, exit 2, nothing written; with
+    --data elsewhere the default --figure (the committed one, drawing 153 cells) is refused."""
+    work, runs, copies = _checkout_with_one_finished_part(tmp_path)
+    before = digests(copies)
+    done = subprocess.run([sys.executable, SCRIPT, "--runs", str(runs), *given], cwd=work,
+                          capture_output=True, text=True, timeout=300)
+    err = done.stderr.strip().splitlines()
+    assert done.returncode == 2, done.stdout + done.stderr
+    assert len(err) == 1 and "of the 153 cells" in err[0] and "Traceback" not in done.stderr
+    assert digests(copies) == before
+    assert not (work / "elsewhere").exists()
+
+
+def test_a_partial_run_tabulates_where_it_is_told(tmp_path):
+    """The refusal's advice works: with --data and --figure elsewhere the finished part is
+    tabulated (12 cells), and tabulating it again there is no shrink."""
+    work, runs, copies = _checkout_with_one_finished_part(tmp_path)
+    before = digests(copies)
+    command = [sys.executable, SCRIPT, "--read-only", "--runs", str(runs), "--data",
+               str(tmp_path / "d"), "--figure", str(tmp_path / "f.png")]
+    for _ in range(2):
+        done = subprocess.run(command, cwd=work, capture_output=True, text=True, timeout=300)
+        assert done.returncode == 0, done.stderr
+    assert len(pd.read_parquet(tmp_path / "d" / "paper_range_summary.parquet")) == 12
+    assert (tmp_path / "f.png").is_file() and digests(copies) == before

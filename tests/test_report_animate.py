@@ -274,3 +274,24 @@ def test_report_names_a_diagram_it_cannot_draw(sweep, tmp_path, monkeypatch):
     page, content = parse(target)
     assert page.images == [] and "not drawn: the table mixes models" in content
     assert len(page.tables["cells"]) == 5
+
+
+def _counts_cell(content, label):
+    """The text of the report's counts row whose header starts with ``label``."""
+    found = re.search(re.escape(label) + r"[^<]*</th><td[^>]*>([^<]*)</td>", content)
+    assert found, label
+    return html.unescape(found.group(1))
+
+
+def test_report_of_rows_without_terminal_state_says_not_recorded(tmp_path):
+    """Issue 54.1: data/convergence_runs/default_t12 (80 rows, none with terminal_state:
+    written before it existed) reported "still moving at their end: 0"."""
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    out = tmp_path / "r.html"
+    assert main(["report", os.path.join(root, "data", "convergence_runs", "default_t12"),
+                 "--out", str(out)]) == 0
+    moving = _counts_cell(out.read_text(encoding="utf-8"), "still moving at their end")
+    assert moving.startswith("not recorded (unknown) for 80 of 80 cases"), moving
+    frame = loopsim.read_results(os.path.join(root, "data", "convergence_runs", "default_t12"))
+    counts = outcome_statistics.outcome_counts(frame)
+    assert counts["unsteady"] is None and counts["unsteady_not_recorded"] == 80

@@ -150,11 +150,48 @@ def test_failed_cases_of_a_seeds_auto_directory_are_rerun(tmp_path, capsys):
     again = loopsim.read_results(out)
     assert list(again["status"]) == ["ok", "ok"] and list(again["seed"]) == [0, 1]
     assert list(again["method"]) == ["radau5"] * 2
-    assert storage.read_stop_table(out).equals(stops)  # why each cell stopped, as written
+    restated = storage.read_stop_table(out)  # issue 54.5: no longer "failed"
+    assert list(stops["stop_reason"]) == ["failed"] and list(stops["runs"]) == ["none"]
+    assert list(restated["stop_reason"]) == ["deterministic"]
+    assert list(restated["runs"]) == ["trajectories"] and list(restated["seeds"]) == [2]
+    assert restated.drop(columns=["stop_reason", "runs", "p_halfwidth",
+                                  "tilt_halfwidth_deg"]).equals(
+        stops.drop(columns=["stop_reason", "runs", "p_halfwidth", "tilt_halfwidth_deg"]))
     assert main(["sweep", "--rerun-failed", out, "--method", "radau5", "--quiet"]) == 0
     assert "reran 0 failed" in capsys.readouterr().out
+    assert storage.read_stop_table(out).equals(restated)  # a second call changes nothing
     unfinished = str(tmp_path / "b")
     shutil.copytree(out, unfinished)
     os.remove(os.path.join(unfinished, storage.STOPS_FILE))
     assert main(["sweep", "--rerun-failed", unfinished, "--rtol", "1e-5"]) == 2
     assert "has not finished" in capsys.readouterr().err
+
+
+def test_the_sweep_command_and_report_after_a_rescue_say_what_the_rows_say(tmp_path, capsys):
+    """Issue 54.5: after --rerun-failed rescued the seeds of a cell stopped as failed,
+    re-running the sweep's command still said "no successful seed ... no distribution,
+    no check", and the report listed the cell as failed next to its p_stable 1.  (The
+    step budget that fails rkf45 here is a Python option: the sweep's command is
+    ``run_seeds_auto`` again; its closing lines print ``stop_counts`` of the table.)"""
+    from loopsim import outcome_statistics
+
+    out = str(tmp_path / "a")
+    config = sweeps.SweepConfig(cases=sweeps.grid_cases([10.0], [30.0], [4], 1), t_end=3.0,
+                                max_steps=150, method="rkf45", twin=False)
+    targets = seeds_auto_rule.SeedTargets(min_seeds=2, max_seeds=2)
+
+    def command():
+        rows, stops = run_seeds_auto(config, out, targets, run_round=lambda c, d, w:
+                                     sweeps.run_sweep(c, d, threads=1, quiet=True))
+        return outcome_statistics.stop_counts(stops)["reasons"]
+
+    assert command() == {"failed": 1}
+    assert main(["sweep", "--rerun-failed", out, "--method", "radau5", "--quiet",
+                 "--threads", "1"]) == 0
+    capsys.readouterr()
+    assert command() == {"deterministic": 1}  # the finished sweep, read back
+    page = str(tmp_path / "a.html")
+    assert main(["report", out, "--out", page]) == 0
+    content = open(page, encoding="utf-8").read()
+    assert "1: deterministic 1" in content and "failed 1" not in content
+    assert loopsim.summarize(loopsim.read_results(out))["p_stable"].tolist() == [1.0]

@@ -277,7 +277,7 @@ def _sampled_cells_text(sampled, config, targets, out):
 
 
 def command(args):
-    from .. import figures, outcome_statistics
+    from .. import figures, outcome_statistics, sweeps
 
     backend = _backend_options(args)
     try:
@@ -287,6 +287,7 @@ def command(args):
                 if hasattr(stopped, "done") else "")
         return interrupted(getattr(stopped, "signum", 2),
                             f"{done}re-run the same command to resume")
+    sweeps.warn_mixed_columns(frame, out)  # a resume across releases says so
     counts = outcome_statistics.outcome_counts(frame)
     _print_outcomes(counts, out, config, frame)
     seeds_auto = args.rerun_failed is None and args.seeds == "auto"
@@ -371,6 +372,8 @@ def _run(args, backend):
 
 def _print_outcomes(counts, out, config, frame):
     """The cases by regime, and those not resolved, not determined or still moving."""
+    from .. import outcome_statistics
+
     print(f"{counts['cases']} cases in {out}: "
           + ", ".join(f"{k} {v}" for k, v in counts["regimes"].items()))
     if counts["unresolved"]:
@@ -387,7 +390,10 @@ def _print_outcomes(counts, out, config, frame):
               "tilt is a sample of an ill-conditioned transient, not an outcome (regimes "
               "among them: " + ", ".join(
                   f"{k} {v}" for k, v in counts["undetermined_regimes"].items()) + ")")
-    if counts.get("unsteady"):
+    if counts["unsteady"] is None:  # rows of an older release: unknown, never 0
+        print(f"still moving at their end (column 'terminal_state'): "
+              + outcome_statistics.unsteady_text(counts))
+    elif counts["unsteady"]:
         print(f"{counts['unsteady']} of {counts['cases']} cases still MOVE at their end "
               "(column 'terminal_state' unsteady): their terminal values are snapshots of "
               "the motion; the late_* columns give its mean and range over the last fifth "

@@ -92,7 +92,8 @@ def probability_phase_diagram(cells, frame=None, ax=None, style="pie"):
                    facecolors="none", edgecolors="#d62728", linewidths=0.9, zorder=4,
                    label="some seeds not determined")
     if "steady" in cells and cells["steady"].sum() > 0:
-        unsteady = cells[cells["steady"] < cells["seeds"]]
+        unsteady = cells[(cells["steady"] < cells["seeds"]).fillna(False).astype(bool)]
+        # (a cell whose steady is unknown, <NA>: never tested, is not marked)
         if len(unsteady):
             ax.scatter(unsteady["theta0_deg"] + 2.2, unsteady["g0"] + 0.035 * cells["g0"].max(),
                        marker="v", s=14, color="k", zorder=5,

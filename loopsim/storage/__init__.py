@@ -20,8 +20,8 @@ from .integrity import (
 from .sweepdir import (
     CHUNK_PATTERN, FINGERPRINT_IGNORES, LAYOUT, QUARANTINE_DIR, RERUN_DIR, SNAPSHOT_DIR,
     SWEEP_FILE, case_order, check_files_belong, check_layout, check_no_overlap, check_rows,
-    chunk_files, config_fingerprint, damaged_files, overlapping, quarantine, read_snapshots,
-    read_sweep_file, requires_hash, result_table, table_metadata,
+    chunk_files, config_fingerprint, damaged_files, mixed_columns_text, overlapping, quarantine,
+    read_snapshots, read_sweep_file, requires_hash, result_table, table_metadata,
 )
 from .seedsdir import (
     CHECK_DIR, ROUND_DIR, SEEDS_FILE, STOPS_FILE, check_round_directory, check_rounds,
@@ -42,7 +42,7 @@ __all__ = [
     "read_snapshots", "read_sweep_file", "read_table_checked", "remove_stale_temporaries",
     "requires_hash", "result_table", "table_metadata", "trajectory_table", "write_json_atomically",
     "CHECK_DIR", "ROUND_DIR", "SEEDS_FILE", "STOPS_FILE", "check_round_directory", "check_rounds",
-    "is_seeds_auto", "read_seeds_auto",
+    "is_seeds_auto", "mixed_columns_text", "read_seeds_auto",
     "read_seeds_file", "read_stop_table", "round_directory",
     "write_file_atomically", "write_table_atomically", "write_trajectory",
 ]

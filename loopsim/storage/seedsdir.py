@@ -111,7 +111,11 @@ def read_seeds_auto(out):
     rows = pd.concat(frames, ignore_index=True)
     rows["case_id"] = range(len(rows))
     meta = dict(frames[0].attrs.get("loopsim", {}))
-    meta.update(seeds_auto=stored["targets"], rounds=len(frames))
+    lacking = {}  # rows lacking a column, over every round (a resume across releases)
+    for frame in frames:
+        for name, count in frame.attrs.get("loopsim", {}).get("not_recorded", {}).items():
+            lacking[name] = lacking.get(name, 0) + count
+    meta.update(seeds_auto=stored["targets"], rounds=len(frames), not_recorded=lacking)
     rows.attrs["loopsim"] = meta
     return rows
 

@@ -236,14 +236,26 @@ def requires_hash(stored):
 #: before (a file written earlier holds local-model rows without these columns).
 ADDED_COLUMNS = {"model": "local", "slenderness": None, "twin_regime": None,
                  "twin_theta_final_deg": None, "twin_aspect_ratio": None,
-                 **{name: None for name in MOTION_FIELDS}}
+                 **{name: None for name in MOTION_FIELDS}, "early_stop": None}
+#: The added columns whose value in an older file's rows is known exactly (the local
+#: model; ``early_stop`` from the sweep's configuration): the others are not recorded
+#: there (null: unknown, :func:`not_recorded_columns`).
+KNOWN_BEFORE = ("model", "slenderness", "early_stop")
 
 
-def result_table(table):
+def not_recorded_columns(table):
+    """The columns of RESULT_SCHEMA that the rows of a result file's ``table`` do not
+    record (added since the file was written, value unknown: not in :data:`KNOWN_BEFORE`)."""
+    return [name for name in ADDED_COLUMNS
+            if name not in KNOWN_BEFORE and name not in table.schema.names]
+
+
+def result_table(table, early_stop=None):
     """A verified result file's table in RESULT_SCHEMA (metadata dropped; columns added
-    since the file was written filled in from ``ADDED_COLUMNS``)."""
+    since the file was written filled in from ``ADDED_COLUMNS``; ``early_stop``: the
+    sweep's, for files written before rows recorded it)."""
     table = table.replace_schema_metadata(None)
-    for name, value in ADDED_COLUMNS.items():
+    for name, value in dict(ADDED_COLUMNS, early_stop=early_stop).items():
         if name not in table.schema.names:
             kind = RESULT_SCHEMA.field(name).type
             table = table.append_column(name, pa.array([value] * table.num_rows, kind))
@@ -294,6 +306,25 @@ def table_metadata(files_meta):
     return meta
 
 
+def mixed_columns_text(frame):
+    """One line where some rows of a results table (``read_results``) lack columns that
+    the others record (a sweep resumed across releases: the older rows were written before
+    the columns existed), naming the columns and how many rows lack each; None where
+    none is mixed."""
+    lacking = frame.attrs.get("loopsim", {}).get("not_recorded", {}) or {}
+    mixed = {name: rows for name, rows in lacking.items() if 0 < rows < len(frame)}
+    if not mixed:
+        return None
+    groups = {}
+    for name, rows in mixed.items():
+        groups.setdefault(rows, []).append(name)
+    parts = [f"{rows} of the {len(frame)} rows lack column(s) {', '.join(names)}"
+             for rows, names in sorted(groups.items(), reverse=True)]
+    return ("; ".join(parts) + ": written by an older release, before the columns existed, "
+            "and resumed by this one; their values (and the counts over them: still moving "
+            "at the end ...) are not recorded (null, unknown) for those rows, never 0")
+
+
 def read_results(out):
     """All finished cases of a sweep directory as a DataFrame sorted by case_id.
 
@@ -315,13 +346,17 @@ def read_results(out):
                              "files): give the directory a sweep's --out named")
         raise ValueError(f"{out!r} has result files but no {SWEEP_FILE} (the sweep's "
                          "configuration): re-run the sweep's command to restore it")
-    tables = {}
+    tables, lacking = {}, {}
+    early_stop = stored["config"].get("early_stop", True)
     for key in sorted(files):
         try:
-            tables[key] = result_table(read_table_checked(files[key], requires_hash(stored)))
+            written = read_table_checked(files[key], requires_hash(stored))
         except DamagedFile as exc:
             raise ValueError(f"{exc}; re-run the sweep's command: it moves the file to "
                              f"{QUARANTINE_DIR}/ and recomputes its cases") from None
+        for name in not_recorded_columns(written):
+            lacking[name] = lacking.get(name, 0) + written.num_rows
+        tables[key] = result_table(written, early_stop)
     check_files_belong(stored, files)
     check_no_overlap(files)
     paths = [files[key] for key in sorted(files)]
@@ -341,6 +376,7 @@ def read_results(out):
     meta.update(sweep_config=stored["config"], thresholds=stored["config"].get("thresholds"),
                 command_line=stored.get("command_line", []),
                 field_notes=stored.get("field_notes", {}), reruns=stored.get("reruns", []),
+                not_recorded=lacking,
                 columns={name: dict(unit=unit, description=text)
                          for name, (unit, text) in columns.RESULT_COLUMNS.items()})
     frame.attrs["loopsim"] = meta

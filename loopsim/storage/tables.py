@@ -56,7 +56,7 @@ RESULT_SCHEMA = pa.schema(
     [pa.field(name, kind, metadata=columns.field_metadata(name)) for name, kind in
      [("case_id", _INT)]
      + [(name, _SUMMARY_TYPES.get(name, _FLOAT)) for name in SUMMARY_FIELDS]
-     + [("stop_reason", pa.string()), ("aspect_ratio_initial", _FLOAT),
+     + [("stop_reason", pa.string()), ("early_stop", pa.bool_()), ("aspect_ratio_initial", _FLOAT),
         ("length_error_max", _FLOAT), ("x_final", pa.list_(_FLOAT))]]
 )
 

@@ -37,7 +37,7 @@ from .cases import (
 )
 from .chunks import canonical_chunks, case_order, chunk_case_ids, pending_pieces
 from .directory import FIELD_NOTES, repair_directory, write_piece
-from .orchestrate import run_sweep, sweep
+from .orchestrate import run_sweep, sweep, warn_mixed_columns
 from .progress import AUTO_COST_EXPONENT, Progress, case_weight
 from .rerun import config_from_dict, rerun_failed
 from .runner import case_ladder, case_method, run_chunk, run_piece
@@ -51,5 +51,5 @@ __all__ = [
     "chunk_case_ids", "classify", "config_from_dict", "grid_cases", "in_background",
     "parse_values", "pending_pieces", "read_cases_file", "repair_directory", "rerun_failed",
     "run_chunk", "run_piece", "run_seeds_auto", "run_sweep", "stop_event",
-    "stop_on_signals", "sweep", "validate", "write_piece",
+    "stop_on_signals", "sweep", "validate", "warn_mixed_columns", "write_piece",
 ]

@@ -101,6 +101,19 @@ def run_sweep(config, out, threads=None, quiet=False, command_line=None, *, sche
     return storage.read_results(out)
 
 
+def warn_mixed_columns(frame, out):
+    """A ``LoopsimWarning`` (one line) where the rows of the sweep in ``out`` mix rows with
+    and without a column (a resume across releases: ``storage.mixed_columns_text``)."""
+    import warnings
+
+    from ..result import LoopsimWarning
+
+    text = storage.mixed_columns_text(frame)
+    if text is not None:
+        warnings.warn(f"{out}: {text}", LoopsimWarning, stacklevel=3)
+    return frame
+
+
 def sweep(g0, theta0_deg, out, *, n="auto", seeds=1, method=None, t_end=DEFAULT_T_END,
           rtol=DEFAULT_RTOL, atol=DEFAULT_ATOL, w=DEFAULT_W, perturbation=DEFAULT_PERTURBATION,
           twin=True, early_stop=True, n_max=DEFAULT_N_MAX, tail_tol=DEFAULT_TAIL_TOL,
@@ -257,5 +270,5 @@ def sweep(g0, theta0_deg, out, *, n="auto", seeds=1, method=None, t_end=DEFAULT_
             run_round=lambda round_config, directory, weights: run_sweep(
                 round_config, directory, weights=weights, **backend),
             command_line=backend["command_line"])
-        return rows
-    return run_sweep(config, os.fspath(out), **backend)
+        return warn_mixed_columns(rows, out)
+    return warn_mixed_columns(run_sweep(config, os.fspath(out), **backend), out)

@@ -9,6 +9,7 @@ from .. import refinement, storage, validation
 from ..outcomes import Thresholds
 from .cases import SweepConfig
 from .orchestrate import run_sweep
+from .seeds_auto import restate_stop_table
 
 
 def config_from_dict(stored):
@@ -76,9 +77,10 @@ def rerun_failed(out, method, rtol, atol, **backend):
 
 def _rerun_rounds(out, method, rtol, atol, **backend):
     """:func:`rerun_failed` on a finished ``--seeds auto`` directory: each round with failed
-    cases is a sweep of its own, rerun in place.  The stop table stays as written (why
-    each cell stopped, with the rows it had then); ``read_results`` and ``summary`` read
-    the rows as they are now."""
+    cases is a sweep of its own, rerun in place.  The stop table's rows of the cells
+    rerun are then decided again from their rows now (``seeds_auto.restate_stop_table``:
+    a cell stopped as failed whose seeds were rescued no longer reads failed);
+    ``read_results`` and ``summary`` read the rows as they are now."""
     if not os.path.isfile(os.path.join(out, storage.STOPS_FILE)):
         raise ValueError(f"the --seeds auto sweep in {out!r} has not finished: re-run its "
                          "command first (its later rounds are planned from these rows)")
@@ -92,6 +94,7 @@ def _rerun_rounds(out, method, rtol, atol, **backend):
         if last is not None and last["merged"] and last["settings"] == settings:
             continue  # rerun with these settings by an earlier, interrupted call
         reran += rerun_failed(directory, method, rtol, atol, **backend)[1]
+    restate_stop_table(out)  # also where an earlier call was cut short before it
     return storage.read_results(out), reran
 
 

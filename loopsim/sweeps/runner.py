@@ -74,7 +74,7 @@ def _result_row(config, case_id, case, x0, x, status_code, counts, worst, wall_s
     row.update(
         case_id=case_id, aspect_ratio_initial=diagnostics.aspect_ratio(x0),
         x_final=x.ravel().tolist(), length_error_max=float(worst[0]),
-        stop_reason=integrators.STOP_REASONS[status_code])
+        stop_reason=integrators.STOP_REASONS[status_code], early_stop=config.early_stop)
     return row
 
 

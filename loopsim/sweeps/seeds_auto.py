@@ -3,8 +3,9 @@
 The directory (``storage.seedsdir``) holds the cells, the targets and the sweep's other
 options, one ordinary sweep directory per round (checksummed, resumable) and, once every
 cell has stopped, the stop table: one row per cell saying why it stopped
-(``seeds_auto_rule``: failed, deterministic, sharp or cap).  Round r's cases are planned from the rows of
-rounds < r only, by ``seeds_auto_rule.decide``; those rows are reproducible bit for bit, so
+(``seeds_auto_rule``: failed, deterministic, sharp or cap; rescued where a later
+``--rerun-failed`` replaced failed runs: :func:`restate_stop_table`).  Round r's cases
+are planned from the rows of rounds < r only, by ``seeds_auto_rule.decide``; those rows are reproducible bit for bit, so
 re-running the command after an interruption plans the same rounds and resumes the one
 it stopped in.  Each round's configuration fingerprint is recorded in the directory's
 record before the round runs, so that a round copied in from elsewhere is refused on
@@ -307,9 +308,63 @@ def run_seeds_auto(config, out, targets, *, run_round, command_line=None, announ
         checks = run_round(check_config(config, cases), os.path.join(out, storage.CHECK_DIR),
                            expected_costs(cases, rows, twins=False))
     table = stop_table(cells, rows, targets, checks)
+    write_stop_table(out, table, targets)
+    return storage.read_seeds_auto(out), table
+
+
+def write_stop_table(out, table, targets):
+    """Write the stop table ``table`` of the ``--seeds auto`` directory ``out`` (atomically,
+    each column described, the targets in its metadata)."""
     meta = storage.provenance(seeds_auto_targets=json.dumps(dataclasses.asdict(targets)))
     storage.write_table_atomically(
         storage.described(pa.Table.from_pandas(table, preserve_index=False)
                           .replace_schema_metadata(meta), columns.STOP_COLUMNS),
         os.path.join(out, storage.STOPS_FILE))
-    return storage.read_seeds_auto(out), table
+
+
+def rerun_cells(out):
+    """The cells (:func:`cell_key`) of the ``--seeds auto`` directory ``out`` holding a
+    case whose failed run a merged ``--rerun-failed`` attempt replaced (from each round's
+    ``_sweep.json``)."""
+    cells = set()
+    index = 0
+    while os.path.isdir(storage.round_directory(out, index)):
+        stored = storage.read_sweep_file(storage.round_directory(out, index)) or {}
+        cases = stored.get("config", {}).get("cases", [])
+        for attempt in stored.get("reruns", []):
+            if attempt.get("merged"):
+                cells.update(cell_key(cases[i]) for i in attempt["case_ids"])
+        index += 1
+    return cells
+
+
+def restate_stop_table(out):
+    """After ``--rerun-failed`` replaced failed runs of the finished ``--seeds auto``
+    directory ``out``: the stop table's rows of the cells it touched (:func:`rerun_cells`)
+    computed again from their rows now (seeds, stop reason, interval half-widths, how
+    their answer was decided, the distribution check), so that nothing derived from it
+    says "failed" of a cell with successful seeds.  A cell the rule would now give more
+    seeds (``seeds_auto_rule.CONTINUE``) stops as ``seeds_auto_rule.RESCUED``: a finished
+    sweep adds none.  The other rows stay as written.  Returns the table."""
+    stops = storage.read_stop_table(out)
+    touched = rerun_cells(out)
+    keys = [tuple(float(v) for v in row) for row in stops[list(CELL_KEYS)].to_numpy()]
+    if not touched & set(keys):
+        return stops
+    record = storage.read_seeds_file(out)
+    targets = seeds_auto_rule.SeedTargets(**record["targets"])
+    cells = [dict(case, seed=0) for case in record["config"]["cases"]]
+    check = os.path.join(out, storage.CHECK_DIR)
+    checks = storage.read_results(check) if os.path.isdir(check) else None
+    fresh = stop_table(cells, storage.read_seeds_auto(out), targets, checks)
+    fresh["stop_reason"] = fresh["stop_reason"].replace(seeds_auto_rule.CONTINUE,
+                                                        seeds_auto_rule.RESCUED)
+    fresh_keys = [tuple(float(v) for v in row) for row in fresh[list(CELL_KEYS)].to_numpy()]
+    by_key = dict(zip(fresh_keys, range(len(fresh))))
+    rows = [fresh.iloc[by_key[key]] if key in touched else stops.iloc[i]
+            for i, key in enumerate(keys)]
+    table = pd.DataFrame(rows, columns=stops.columns).reset_index(drop=True).astype(
+        stops.dtypes.to_dict())
+    if not table.equals(stops):
+        write_stop_table(out, table, targets)
+    return table
