@@ -136,15 +136,16 @@ def _figures(frame, cells, seeds_auto):
 SETTLING_SHOWN = ("at_rest", "rest_observed", "p_rest_t10", "p_rest_t10_low", "p_rest_t10_high",
                   "t_rest_median", "t_rest_median_low", "t_rest_median_high", "t_rest_q95",
                   "escape_events", "escape_rate", "escape_rate_low", "escape_rate_high")
-#: The survival curves are drawn for at most this many cells (one curve each).
+#: The survival curves are drawn for at most this many cells (one curve each), and only
+#: for a sweep run past the paper's horizon (a run-to-rest sweep, ``--t-end`` > 10).
 SURVIVAL_CELLS_MAX = 10
 
 
 def _settling(frame, cells):
     """The settling section: per cell, how many came to rest, P(at rest by t = 10), the
     median settling time and the escape rate (``loopsim.survival``), and the survival
-    curves for a few cells; empty where the rows were not tested for rest."""
-    from . import figures
+    curves of a run-to-rest sweep; empty where the rows were not tested for rest."""
+    from . import figures, survival
 
     if "at_rest" not in cells:
         return ""
@@ -155,7 +156,7 @@ def _settling(frame, cells):
              "median settling time are Kaplan–Meier estimates with 95 % intervals; NaN: "
              "not reached within the runs (docs/sweeps.md).</p>",
              table_html(cells, inputs + [c for c in SETTLING_SHOWN if c in cells], "settling")]
-    if len(cells) <= SURVIVAL_CELLS_MAX:
+    if len(cells) <= SURVIVAL_CELLS_MAX and frame["t_end"].max() > survival.PAPER_HORIZON:
         fig = figures.survival_curves(frame)
         parts.append(f"<img alt='survival of not yet at rest' src='{png_data_uri(fig)}'>")
     return "".join(parts)

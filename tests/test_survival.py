@@ -82,7 +82,7 @@ def cell(times, reasons, g0=350.0, theta=18.0, tilts=None):
     """A fabricated cell: one row per run."""
     k = len(times)
     return pd.DataFrame(dict(
-        g0=g0, theta0_deg=theta, seed=range(k), t_final=times, stop_reason=reasons,
+        g0=g0, theta0_deg=theta, seed=range(k), t_final=times, t_end=40.0, stop_reason=reasons,
         regime="3d", resolved=True, determined=pd.NA, twin_nfev=0, nfev=1, wall_s=1.0,
         theta_final_deg=tilts if tilts is not None else [10.0] * k, aspect_ratio=2.0,
         q_final=1.0))
