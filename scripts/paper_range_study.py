@@ -71,6 +71,7 @@ import pandas as pd
 from loopsim import cli, columns, outcome_statistics, storage
 from loopsim.cli.common import print_and_write, use_agg
 from loopsim.figures import save_distribution_figure
+from loopsim.stability import rest_window
 
 #: The paper's grid: g0 = 10..350 in 15 values, θ0 = 6..90° in 15.
 G0 = np.linspace(10.0, 350.0, 15)
@@ -329,7 +330,8 @@ def main():
     stop = pd.concat(stops, ignore_index=True).drop(columns="part")
     stop["n"] = stop["n"].astype("int64")
     check_rows = pd.concat(checks, ignore_index=True) if checks else pd.DataFrame()
-    table = outcome_statistics.summarize(frame.drop(columns="part"))
+    window = rest_window.stability_losses()  # where loops can rest: counted and drawn
+    table = outcome_statistics.summarize(frame.drop(columns="part"), rest_window=window)
     refuse_if_shrinking(args, cell_keys(table) & cell_keys(stop))  # the cells as run
     os.makedirs(args.data, exist_ok=True)
     meta = dict(summary_of=" + ".join(sorted(set(frame["part"]))))
@@ -343,7 +345,8 @@ def main():
     print_findings(table, frame.drop(columns="part"), check_rows)
     if args.figure:
         use_agg()
-        save_distribution_figure(table, frame.drop(columns="part"), args.figure, dpi=FIGURE_DPI)
+        save_distribution_figure(table, frame.drop(columns="part"), args.figure, dpi=FIGURE_DPI,
+                                 rest_window=window)
         print(f"figure: {args.figure}")
 
 

@@ -63,15 +63,20 @@ def check_one_cell_per_point(cells):
     return cells
 
 
-def probability_phase_diagram(cells, frame=None, ax=None, style="pie"):
+def probability_phase_diagram(cells, frame=None, ax=None, style="pie", rest_window=None):
     """The phase diagram read as probabilities: each cell of a summary table
     (``loopsim.summarize``) at (θ0, g0) as a pie of its regime probabilities
     (``style="pie"``, :func:`regime_pies`) or coloured by its probability of ending 3D
     (``style="colour"``, labelled with P(in-plane) when it is neither 0 nor 1); ringed
     red where any seed is not determined, marked by a black triangle where any seed had
     not reached a steady state at ``t_end`` (its tilt is then a snapshot: only when some
-    run of the table did stop early, so not for ``--no-early-stop``); with the full
-    linearisation's thresholds (``q_c`` at n = 16)."""
+    run of the table did stop early, so not for ``--no-early-stop``), with P(not at rest
+    by t = 10) beside it where the table has ``p_rest_t10``; with the full
+    linearisation's thresholds (``q_c`` at n = 16).  With ``rest_window``
+    (``loopsim.stability.rest_window.RestWindow``) also the upper edge of the stable
+    branch's window, q = q_loss: the in-plane threshold q_c is its lower edge, so a cell
+    between the two curves starts inside its window, one above the upper curve above it
+    (it must turn its plane before it can rest)."""
     if style not in ("pie", "colour"):
         raise ValueError(f"style must be 'pie' or 'colour', got {style!r}")
     check_one_cell_per_point(cells)
@@ -97,12 +102,24 @@ def probability_phase_diagram(cells, frame=None, ax=None, style="pie"):
         if len(unsteady):
             ax.scatter(unsteady["theta0_deg"] + 2.2, unsteady["g0"] + 0.035 * cells["g0"].max(),
                        marker="v", s=14, color="k", zorder=5,
-                       label="some seeds not steady at t_end")
+                       label="some seeds not steady at t_end" + (
+                           " (number: P(not at rest by t = 10))" if "p_rest_t10" in cells
+                           else ""))
+            if "p_rest_t10" in cells:
+                for _, cell in unsteady.iterrows():
+                    ax.annotate(f"{1.0 - cell['p_rest_t10']:.2f}",
+                                (cell["theta0_deg"] + 3.2, cell["g0"] + 0.035 * cells["g0"].max()),
+                                fontsize=5, va="center", zorder=5)
     theta = np.linspace(1.0, 90.0, 300)
     for sector, line in (("in-plane", "--"), ("out-of-plane", ":")):
         q_sector = full_linear.critical_q(16, sector)
         ax.plot(theta, 3 * q_sector / np.sin(np.radians(theta)), "k", ls=line, lw=1.0,
                 label=f"{sector} threshold, q = {q_sector:.3f}")
+    if rest_window is not None:
+        loss = rest_window.losses[0]
+        ax.plot(theta, 3 * loss.q / np.sin(np.radians(theta)), color="tab:green", lw=1.2,
+                label=f"stable branch's upper edge ({loss.kind.replace('hopf', 'Hopf')}, "
+                      f"{loss.sector}), q = {loss.q:.3f}")
     ax.set_xlim(0, 92)
     ax.set_ylim(0, 1.08 * cells["g0"].max())
     ax.set_xlabel(r"initial tilt $\theta_0$ (deg)")
@@ -176,28 +193,31 @@ def aspect_distribution(cells, frame=None, branch=None, ax=None):
     return fig
 
 
-def distribution_summary(cells, frame, branch=None):
+def distribution_summary(cells, frame, branch=None, rest_window=None):
     """The panels of a summary table (``outcome_statistics.summarize``) and its rows: the regime
     probabilities per cell (:func:`probability_phase_diagram`), the terminal tilt over the seeds
     (:func:`tilt_distribution`) and, when the table has terminal q, the aspect ratio
-    over the steady branch ``branch`` (:func:`aspect_distribution`)."""
+    over the steady branch ``branch`` (:func:`aspect_distribution`); ``rest_window``: as
+    :func:`probability_phase_diagram`'s."""
     panels = 3 if "q_final_median" in cells else 2
     fig, axes = plt.subplots(1, panels, figsize=(6.6 * panels, 4.4), constrained_layout=True)
-    probability_phase_diagram(cells, ax=axes[0])
+    probability_phase_diagram(cells, ax=axes[0], rest_window=rest_window)
     tilt_distribution(cells, frame, ax=axes[1])
     if panels == 3:
         aspect_distribution(cells, frame, branch=branch, ax=axes[2])
     return fig
 
 
-def save_distribution_figure(table, frame, path, dpi=150):
+def save_distribution_figure(table, frame, path, dpi=150, rest_window=None):
     """Draw a summary table and its rows (:func:`distribution_summary`) to ``path``: for
     the local model over its steady branch up to the largest terminal q seen, rounded up
-    to a multiple of 5 (at most :data:`BRANCH_Q_MAX`)."""
+    to a multiple of 5 (at most :data:`BRANCH_Q_MAX`), with the stable branch's window
+    where ``rest_window`` is given."""
     branch = None
     q_final = frame["q_final"].to_numpy(float) if "q_final" in frame else []
     q_seen = [float(q) for q in q_final if q == q]
     if frame_model(frame).name == "local" and q_seen:
         branch = steady.steady_branch_to(
             min(BRANCH_Q_MAX, 5.0 * math.ceil(1.05 * max(q_seen) / 5.0) or 5.0))
-    save(distribution_summary(table, frame, branch=branch), path, dpi=dpi)
+    save(distribution_summary(table, frame, branch=branch, rest_window=rest_window), path,
+         dpi=dpi)
