@@ -9,8 +9,9 @@ revision REV for ``--baseline``, through ``git archive``) into a new temporary
 directory, as a fresh clone has it (no ``__pycache__``, new timestamps), points
 ``NUMBA_CACHE_DIR`` and ``XDG_CACHE_HOME`` at new empty directories, and runs
 ``python -m loopsim COMMAND`` there in a subprocess: its wall time, its CPU time (user +
-system of the child process, ``os.times``) and, for a run (``--json`` added), the
-``compile_s`` it reports.  Only the installed
+system of the child process, ``os.times``), the number of specialisations it compiled
+and cached (object files ``*.nbc`` written to the empty cache: one per function and
+argument types) and, for a run (``--json`` added), the ``compile_s`` it reports.  Only the installed
 dependencies (NumPy, Numba, ...) are shared with other runs.  With ``--baseline`` the
 two trees alternate (baseline first), so that a machine whose speed drifts, or that
 other jobs share, affects both alike; compare them only within one invocation.
@@ -39,8 +40,13 @@ def package_copy(revision, into):
     subprocess.run(["tar", "-x", "-C", into], input=archive, check=True)
 
 
+def cached_specialisations(directory):
+    """How many compiled specialisations Numba cached below ``directory`` (object files)."""
+    return sum(name.endswith(".nbc") for _, _, names in os.walk(directory) for name in names)
+
+
 def cold_run(revision, command):
-    """One cold run of ``command``: (wall s, exit code, stdout, stderr)."""
+    """One cold run of ``command``: (wall s, exit code, stdout, stderr, specialisations cached)."""
     with tempfile.TemporaryDirectory(prefix="loopsim-cold-") as tmp:
         os.mkdir(os.path.join(tmp, "src"))
         package_copy(revision, os.path.join(tmp, "src"))
@@ -54,7 +60,7 @@ def cold_run(revision, command):
                                    stderr=subprocess.PIPE, text=True)
         stdout, stderr = process.communicate()
         wall = time.perf_counter() - started
-        return wall, process.returncode, stdout, stderr
+        return wall, process.returncode, stdout, stderr, cached_specialisations(tmp)
 
 
 def main():
@@ -72,11 +78,11 @@ def main():
     rows = []
     print(f"`loopsim {args.command}`, empty caches, {os.cpu_count()} CPUs, "
           f"load average {os.getloadavg()[0]:.1f} at the start")
-    print(f"{'tree':<14} {'wall_s':>7} {'cpu_s':>7} {'compile_s':>9}")
+    print(f"{'tree':<14} {'wall_s':>7} {'cpu_s':>7} {'compile_s':>9} {'compiled':>8}")
     for repeat in range(args.repeats):
         for revision in trees:
             before = os.times()
-            wall, code, stdout, stderr = cold_run(revision, args.command)
+            wall, code, stdout, stderr, specialisations = cold_run(revision, args.command)
             after = os.times()
             cpu = (after.children_user - before.children_user
                    + after.children_system - before.children_system)
@@ -86,8 +92,10 @@ def main():
                          if shlex.split(args.command)[0] == "run" else float("nan"))
             name = revision or "working tree"
             rows.append(dict(tree=name, repeat=repeat, wall_s=wall, cpu_s=cpu,
-                             compile_s=compile_s, load=os.getloadavg()[0]))
-            print(f"{name:<14} {wall:7.1f} {cpu:7.1f} {compile_s:9.1f}", flush=True)
+                             compile_s=compile_s, compiled=specialisations,
+                             load=os.getloadavg()[0]))
+            print(f"{name:<14} {wall:7.1f} {cpu:7.1f} {compile_s:9.1f} {specialisations:8d}",
+                  flush=True)
     print(f"load average {os.getloadavg()[0]:.1f} at the end")
     if args.out:
         with open(args.out, "w") as handle:

@@ -13,7 +13,8 @@ higher n, another perturbation size) are compared statistic by statistic:
       high = Δ + sqrt((u_b − p̂_b)² + (p̂_a − l_a)²);
 
 * a tilt (or aspect-ratio) quantile: the difference Q_b − Q_a with a percentile-bootstrap
-  interval, each sample resampled on its own from a seeded generator.
+  interval (``scipy.stats.bootstrap``), each sample resampled on its own from a seeded
+  generator.
 
 A statistic *differs* when its interval excludes 0.  The intervals are 95 % each; over
 the k statistics of one comparison the verdict uses Bonferroni's 1 − 0.05/k intervals, so
@@ -27,12 +28,12 @@ binomial distributions at the observed p̂_a; for a quantile, (z₀.₉₇₅ + 
 the bootstrap standard deviation of the difference.  A difference smaller than that is
 not excluded by a verdict of "same".
 
-Plain NumPy: nothing here integrates.
+Plain NumPy and SciPy: nothing here integrates.
 """
 import numpy as np
 from scipy.stats import binom, norm
 
-from .outcome_statistics import Z95, wilson_interval
+from .outcome_statistics import percentile_bootstrap, wilson_interval
 
 #: Probability of detecting a difference of the stated size (the power of ``*_detectable``).
 POWER = 0.8
@@ -48,32 +49,34 @@ CERTAIN_LOWER = 0.8
 SAME, DIFFERENT = "same within the intervals", "different"
 
 
-def newcombe_interval(hits_a, trials_a, hits_b, trials_b, z=Z95):
-    """(low, high) of Newcombe's hybrid score interval of p_b − p_a (module docstring)."""
+def newcombe_interval(hits_a, trials_a, hits_b, trials_b, level=0.95):
+    """(low, high) of Newcombe's hybrid score interval of p_b − p_a (module docstring),
+    from the two Wilson intervals at confidence ``level``."""
     p_a, p_b = hits_a / trials_a, hits_b / trials_b
-    low_a, high_a = wilson_interval(hits_a, trials_a, z)
-    low_b, high_b = wilson_interval(hits_b, trials_b, z)
+    low_a, high_a = wilson_interval(hits_a, trials_a, level)
+    low_b, high_b = wilson_interval(hits_b, trials_b, level)
     delta = p_b - p_a
     return (float(delta - np.hypot(p_b - low_b, high_a - p_a)),
             float(delta + np.hypot(high_b - p_b, p_a - low_a)))
 
 
-def _excludes_zero_table(trials_a, trials_b, z):
+def _excludes_zero_table(trials_a, trials_b, level):
     """Boolean (trials_a + 1, trials_b + 1): whether the Newcombe interval at counts
     (i, j) excludes 0."""
     table = np.zeros((trials_a + 1, trials_b + 1), dtype=bool)
     for i in range(trials_a + 1):
         for j in range(trials_b + 1):
-            low, high = newcombe_interval(i, trials_a, j, trials_b, z)
+            low, high = newcombe_interval(i, trials_a, j, trials_b, level)
             table[i, j] = low > 0.0 or high < 0.0
     return table
 
 
-def detectable_probability_difference(p_a, trials_a, trials_b, power=POWER, z=Z95):
+def detectable_probability_difference(p_a, trials_a, trials_b, power=POWER, level=0.95):
     """Smallest |Δ| on a 0.01 grid such that, with true probabilities p_a and p_a + Δ
     (either sign, inside [0, 1]), the Newcombe interval excludes 0 with probability
-    ≥ ``power`` (exact binomial sums); NaN when no Δ reaches it."""
-    excludes = _excludes_zero_table(trials_a, trials_b, z)
+    ≥ ``power`` (exact binomial sums; the interval at confidence ``level``); NaN when no
+    Δ reaches it."""
+    excludes = _excludes_zero_table(trials_a, trials_b, level)
     weights_a = binom.pmf(np.arange(trials_a + 1), trials_a, p_a)
     for delta in np.arange(0.01, 1.0 + 1e-9, 0.01):
         for p_b in (p_a + delta, p_a - delta):
@@ -86,16 +89,19 @@ def detectable_probability_difference(p_a, trials_a, trials_b, power=POWER, z=Z9
 
 def bootstrap_quantile_differences(a, b, quantile, resamples=RESAMPLES, seed=0):
     """(Δ, draws) for Q_b − Q_a, the ``quantile`` of the finite values of a and b: the
-    sample difference and ``resamples`` bootstrap draws of it (None, None if either
-    sample is empty)."""
+    sample difference and ``resamples`` bootstrap draws of it
+    (:func:`loopsim.outcome_statistics.percentile_bootstrap`: a then b resampled from
+    ``default_rng(seed)``); (None, None) if either sample is empty."""
     a, b = np.asarray(a, float), np.asarray(b, float)
     a, b = a[np.isfinite(a)], b[np.isfinite(b)]
     if not (a.size and b.size):
         return None, None
-    rng = np.random.default_rng(seed)
-    draws_a = np.quantile(a[rng.integers(0, a.size, (resamples, a.size))], quantile, axis=1)
-    draws_b = np.quantile(b[rng.integers(0, b.size, (resamples, b.size))], quantile, axis=1)
-    return float(np.quantile(b, quantile) - np.quantile(a, quantile)), draws_b - draws_a
+
+    def difference(x, y, axis=-1):
+        return np.quantile(y, quantile, axis=axis) - np.quantile(x, quantile, axis=axis)
+
+    _, _, draws = percentile_bootstrap([a, b], difference, resamples, seed)
+    return float(np.quantile(b, quantile) - np.quantile(a, quantile)), draws
 
 
 def percentile_interval(draws, level):
@@ -146,7 +152,7 @@ def compare_samples(a, b, probabilities, quantiles=TILT_QUANTILES, seed=0):
         Bonferroni interval (module docstring) excludes 0.
     """
     statistics = len(probabilities) + len(quantiles)
-    z_family = float(norm.ppf(1 - 0.05 / (2 * statistics)))
+    level_family = 1 - 0.05 / statistics
     out, differs = {}, False
     for column in probabilities:
         x, y = a[column].dropna().astype(bool), b[column].dropna().astype(bool)
@@ -161,7 +167,7 @@ def compare_samples(a, b, probabilities, quantiles=TILT_QUANTILES, seed=0):
                                                                     len(y))
         out[f"{name}_detectable"] = detectable_probability_difference(hits_a / len(x), len(x),
                                                                       len(y))
-        low, high = newcombe_interval(hits_a, len(x), hits_b, len(y), z_family)
+        low, high = newcombe_interval(hits_a, len(x), hits_b, len(y), level_family)
         differs |= low > 0.0 or high < 0.0
     for i, quantile in enumerate(quantiles):
         name = f"delta_tilt_q{round(100 * quantile)}"
@@ -174,7 +180,7 @@ def compare_samples(a, b, probabilities, quantiles=TILT_QUANTILES, seed=0):
         out[name] = delta
         out[f"{name}_low"], out[f"{name}_high"] = percentile_interval(draws, 0.95)
         out[f"{name}_detectable"] = detectable_from_draws(draws)
-        low, high = percentile_interval(draws, 1 - 0.05 / statistics)  # the same draws
+        low, high = percentile_interval(draws, level_family)  # the same draws
         differs |= bool(low > 0.0 or high < 0.0)
     out["verdict"] = DIFFERENT if differs else SAME
     return out

@@ -11,21 +11,25 @@ two rows with one seed in one cell differ in an input the table does not record 
   them are resolved and determined (``loopsim.outcomes``) and reached a steady state
   before ``t_end`` (unknown, ``<NA>``, where a row ran without the early stop:
   ``rows_tested``);
-* ``p_<regime>`` for each regime, with its 95 % Wilson score interval
+* ``p_<regime>`` for each regime, with its 95 % Wilson score interval (no continuity
+  correction; ``scipy.stats.binomtest(k, N).proportion_ci(method="wilson")``)
   ``p_<regime>_low``, ``p_<regime>_high``:
 
       (p̂ + z²/2N ± z sqrt(p̂(1 − p̂)/N + z²/4N²)) / (1 + z²/N),  z = Φ⁻¹(0.975)
 
 * the median and quartiles of the terminal tilt, aspect ratio and q (``tilt_*``,
   ``aspect_*``, ``q_final_*``), each median with a 95 % percentile-bootstrap interval
-  (``BOOTSTRAP_RESAMPLES`` resamples from a generator seeded with ``seed``, so the
-  table is reproducible bit for bit);
+  (``scipy.stats.bootstrap(method="percentile")``, ``BOOTSTRAP_RESAMPLES`` resamples
+  from ``numpy.random.default_rng(seed)``, so the table is reproducible);
 * the cost: ``nfev`` and ``twin_nfev`` summed, ``wall_s`` summed.
 
-Plain NumPy and pandas: no integration happens here.
+Plain NumPy, SciPy and pandas: no integration happens here.
 """
+import functools
+
 import numpy as np
 import pandas as pd
+from scipy import stats
 
 from . import survival
 from .outcomes import REGIMES
@@ -42,30 +46,90 @@ CELL_INPUTS = ("g0", "theta0_deg", "model", "slenderness", "n", "t_end", "rtol",
                "perturbation", "method")
 
 
-def wilson_interval(successes, trials, z=Z95):
-    """(low, high) of the Wilson score interval of a proportion successes / trials."""
+@functools.lru_cache(maxsize=4096)
+def wilson_interval(successes, trials, level=0.95):
+    """The Wilson score interval of a proportion (module docstring), without continuity
+    correction, by ``scipy.stats.binomtest(successes, trials).proportion_ci``.
+
+    Parameters
+    ----------
+    successes, trials : int
+        The count and the number of trials (0 <= successes <= trials).
+    level : float, default 0.95
+        Confidence level of the two-sided interval.
+
+    Returns
+    -------
+    (float, float)
+        (low, high); (nan, nan) with no trials.
+    """
     if trials <= 0:
         return float("nan"), float("nan")
-    p = successes / trials
-    centre = (p + z * z / (2 * trials)) / (1 + z * z / trials)
-    half = z * np.sqrt(p * (1 - p) / trials + z * z / (4 * trials * trials)) / (1 + z * z / trials)
-    return float(max(0.0, centre - half)), float(min(1.0, centre + half))
+    interval = stats.binomtest(int(successes), int(trials)).proportion_ci(
+        confidence_level=level, method="wilson")
+    return float(interval.low), float(interval.high)
+
+
+def percentile_bootstrap(samples, statistic, resamples=BOOTSTRAP_RESAMPLES, seed=0,
+                         level=0.95, vectorized=True):
+    """The percentile bootstrap of ``statistic(*samples)`` by ``scipy.stats.bootstrap``.
+
+    Each sample is resampled on its own (unpaired), in order, from
+    ``numpy.random.default_rng(seed)``.  A sample of one value is held fixed: every
+    resample of it is that value (SciPy refuses samples of fewer than two values, and
+    NumPy draws nothing for them either).
+
+    Parameters
+    ----------
+    samples : sequence of 1-D arrays
+        The samples, each of at least one value.
+    statistic : callable
+        ``statistic(*samples, axis=-1)`` with ``vectorized``, else ``statistic(*samples)``
+        of 1-D samples.
+    resamples : int
+        Bootstrap resamples.
+    seed : int
+        Seed of the generator.
+    level : float
+        Confidence level of the two-sided percentile interval.
+    vectorized : bool
+        Whether ``statistic`` takes ``axis``.
+
+    Returns
+    -------
+    (float, float, numpy.ndarray)
+        (low, high, the bootstrap draws of the statistic).
+    """
+    samples = [np.asarray(sample, dtype=float) for sample in samples]
+    varying = [i for i, sample in enumerate(samples) if sample.size > 1]
+
+    def with_fixed(*drawn, **axis):
+        full = list(samples)
+        for i, sample in zip(varying, drawn):
+            full[i] = sample
+        return statistic(*full, **axis)
+
+    if not varying:
+        value = float(statistic(*samples, **({"axis": -1} if vectorized else {})))
+        return value, value, np.full(resamples, value)
+    result = stats.bootstrap([samples[i] for i in varying], with_fixed, n_resamples=resamples,
+                             vectorized=vectorized, paired=False, confidence_level=level,
+                             method="percentile", rng=np.random.default_rng(seed))
+    interval = result.confidence_interval
+    return float(interval.low), float(interval.high), result.bootstrap_distribution
 
 
 def bootstrap_interval(values, statistic=np.median, resamples=BOOTSTRAP_RESAMPLES, seed=0,
                        level=0.95):
-    """(low, high) percentile-bootstrap interval of ``statistic`` of the finite
-    ``values``: ``resamples`` resamples with replacement from ``default_rng(seed)``."""
+    """(low, high) percentile-bootstrap interval of ``statistic`` (a NumPy reduction taking
+    ``axis``) of the finite ``values``: :func:`percentile_bootstrap` with ``resamples``
+    resamples from ``default_rng(seed)``; (nan, nan) without finite values."""
     values = np.asarray(values, dtype=float)
     values = values[np.isfinite(values)]
     if values.size == 0:
         return float("nan"), float("nan")
-    rng = np.random.default_rng(seed)
-    draws = values[rng.integers(0, values.size, size=(resamples, values.size))]
-    estimates = statistic(draws, axis=1)
-    tail = 100 * (1 - level) / 2
-    low, high = np.percentile(estimates, [tail, 100 - tail])
-    return float(low), float(high)
+    low, high, _ = percentile_bootstrap([values], statistic, resamples, seed, level)
+    return low, high
 
 
 def cell_columns(frame):
@@ -360,20 +424,18 @@ def _paired_cells(a, b, by):
 
 
 def wasserstein_interval(x, y, resamples=BOOTSTRAP_RESAMPLES, seed=0, level=0.95):
-    """(distance, low, high): the 1-Wasserstein distance between the samples x and y with
-    a percentile-bootstrap interval (each sample resampled on its own, seeded)."""
+    """(distance, low, high): the 1-Wasserstein distance between the finite values of x
+    and y with a percentile-bootstrap interval (:func:`percentile_bootstrap`: each sample
+    resampled on its own, seeded); NaN three times if either sample is empty."""
     from scipy.stats import wasserstein_distance
 
     x, y = np.asarray(x, float), np.asarray(y, float)
     x, y = x[np.isfinite(x)], y[np.isfinite(y)]
     if not (x.size and y.size):
         return float("nan"), float("nan"), float("nan")
-    rng = np.random.default_rng(seed)
-    draws = [wasserstein_distance(x[rng.integers(0, x.size, x.size)],
-                                  y[rng.integers(0, y.size, y.size)]) for _ in range(resamples)]
-    tail = 100 * (1 - level) / 2
-    low, high = np.percentile(draws, [tail, 100 - tail])
-    return float(wasserstein_distance(x, y)), float(low), float(high)
+    low, high, _ = percentile_bootstrap([x, y], wasserstein_distance, resamples, seed, level,
+                                        vectorized=False)
+    return float(wasserstein_distance(x, y)), low, high
 
 
 def compare(a, b, by=None, alpha=0.05, seed=0, resamples=500):

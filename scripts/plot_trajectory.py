@@ -13,7 +13,7 @@ import matplotlib
 matplotlib.use("Agg")
 
 from loopsim import figures  # noqa: E402
-from loopsim.figures.suite import read_run  # noqa: E402
+from loopsim.figures.suite import read_run, run_title  # noqa: E402
 
 
 def main(path, figure):
@@ -21,8 +21,9 @@ def main(path, figure):
         trajectory, summary = read_run(path)
     except ValueError as exc:
         sys.exit(f"plot_trajectory: error: {exc}")
-    title = f"g0 = {summary['g0']:g}, θ0 = {summary['theta0_deg']:g}°, n = {summary['n']}"
-    fig = figures.trajectory(trajectory, summary["n"], title)
+    # the snapshots are stored at the order the run ended at (n_used), which with --n auto
+    # is not the starting n: figures.trajectory reads it from the coefficients themselves
+    fig = figures.trajectory(trajectory, title=run_title(summary))
     figures.save(fig, figure, dpi=150)
     print(f"wrote {figure}")
 

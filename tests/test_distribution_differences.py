@@ -96,3 +96,19 @@ def test_the_verdict_sees_a_large_difference():
 
 def test_certain_means_a_wilson_lower_end_of_at_least_0_8():
     assert dd.certain(16, 16) and not dd.certain(8, 8) and not dd.certain(15, 16)
+
+
+def test_quantile_difference_draws_are_the_seeded_resamples_of_a_then_b():
+    """The bootstrap through scipy draws a's resamples, then b's, from default_rng(seed)
+    (the draws loopsim made by hand before issue 55, bit for bit), so that
+    data/convergence_top.parquet's differences are reproduced exactly."""
+    rng = np.random.default_rng(5)
+    a, b = rng.normal(20.0, 5.0, 16), rng.normal(24.0, 5.0, 12)
+    draws_rng = np.random.default_rng(9)
+    draws_a = np.quantile(a[draws_rng.integers(0, a.size, (2000, a.size))], 0.25, axis=1)
+    draws_b = np.quantile(b[draws_rng.integers(0, b.size, (2000, b.size))], 0.25, axis=1)
+    delta, draws = dd.bootstrap_quantile_differences(a, b, 0.25, 2000, seed=9)
+    assert np.array_equal(draws, draws_b - draws_a)
+    assert delta == np.quantile(b, 0.25) - np.quantile(a, 0.25)
+    one = dd.bootstrap_quantile_differences([3.0], b, 0.5, 500, seed=1)[1]
+    assert one.shape == (500,) and np.all(np.isfinite(one))

@@ -373,6 +373,38 @@ def test_plot_trajectory_script_draws_the_loop_near_its_centroid(tiny, tmp_path,
     assert 0.5 < extent < 3.0
 
 
+def test_plot_trajectory_script_draws_an_n_auto_run_at_the_order_it_ended_at(tmp_path,
+                                                                             monkeypatch):
+    """README's first plot: ``loopsim run`` at the default ``--n auto`` starts at n = 6 and
+    stores its snapshots at n_used (16 here, climbed before t = 0.2); the script reads
+    that order from the file instead of reshaping with the starting n (audit N1: it
+    raised "cannot reshape array of size 99 into shape (3,13)")."""
+    run = tmp_path / "auto.parquet"
+    assert main(["run", "--g0", "60", "--theta0", "30", "--t-end", "0.2", "--snapshots", "5",
+                 "--out", str(run)]) == 0
+    _, summary = figures.read_run(str(run))
+    assert summary["n"] == 6 and summary["n_used"] > summary["n"]
+    drawn = {}
+    monkeypatch.setattr(figures, "save", lambda fig, path, dpi=200: drawn.setdefault("fig", fig))
+    script = runpy.run_path(os.path.join(ROOT, "scripts", "plot_trajectory.py"))
+    script["main"](str(run), str(tmp_path / "auto.png"))
+    fig = drawn["fig"]
+    assert len(fig.axes[0].get_lines()) == 5
+    assert f"n_used = {summary['n_used']}" in fig.axes[0].get_title()
+
+
+def test_trajectory_figure_reads_the_order_from_the_snapshots_and_checks_a_given_one():
+    """figures.trajectory needs no order (it reads it from the stored coefficients); one
+    given that the coefficients do not have raises ValueError naming it."""
+    frame = pd.DataFrame({"t": [0.0, 1.0], "theta_deg": [30.0, 31.0], "aspect_ratio": [1.0, 1.1],
+                          "x": [ellipse(30.0, n=8).ravel(), ellipse(31.0, 1.05, n=8).ravel()]})
+    assert len(figures.trajectory(frame).axes[0].get_lines()) == 2
+    assert len(figures.trajectory(frame, 8).axes[0].get_lines()) == 2
+    with pytest.raises(ValueError, match="n = 6"):
+        figures.trajectory(frame, 6)
+    plt.close("all")
+
+
 def test_undetermined_rows_are_ringed_in_the_phase_diagram_and_figs_7_8():
     """Rows whose twin ended elsewhere (determined False) get one red ring each and one
     legend entry; a table without undetermined rows gets none."""

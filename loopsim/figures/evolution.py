@@ -164,12 +164,29 @@ def tension_figure(trajectory, rows=(0, -1), title=""):
     return fig
 
 
-def trajectory(frame, n, title="", axes=None):
+def trajectory(frame, n=None, title="", axes=None):
     """Snapshots of one run (a trajectory table: columns t, x, theta_deg, aspect_ratio):
     left, the loop seen face-on (each snapshot, centred on its centre of mass, projected
     on the plane of the last snapshot's two largest principal axes) and coloured by time,
-    with a colour bar; right, tilt and aspect ratio against time.  ``axes``: a pair, or
-    None."""
+    with a colour bar; right, tilt and aspect ratio against time.
+
+    Parameters
+    ----------
+    frame : pandas.DataFrame
+        The trajectory table (``loopsim run --out``, ``storage.trajectory_table``).
+    n : int, optional
+        The order the snapshots are stored at (``n_used`` of an ``--n auto`` run, not its
+        starting ``n``). None (default) reads it from the stored coefficients; a value
+        that does not match them raises ValueError.
+    title : str
+        Drawn above the left panel.
+    axes : pair of matplotlib axes, optional
+        Where to draw; None makes a new figure.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
     if axes is None:
         fig, axes = plt.subplots(1, 2, figsize=(9.6, 3.9), constrained_layout=True)
     ax_shape, ax_time = axes
@@ -177,7 +194,7 @@ def trajectory(frame, n, title="", axes=None):
     times = frame["t"].to_numpy(float)
     cmap = plt.get_cmap("viridis_r")  # light yellow first, dark purple last (as the paper)
     norm = Normalize(vmin=times.min(), vmax=times.max() if times.max() > times.min() else times.min() + 1)
-    shapes = [np.array(c, dtype=float).reshape(3, 2 * n + 1) for c in frame["x"]]
+    shapes = [coefficients(c, n).copy() for c in frame["x"]]  # copies: centred below
     _, vectors = diagnostics.principal_axes(shapes[-1])
     major, minor = vectors[:, 2], vectors[:, 1]
     for t, x in zip(times, shapes):

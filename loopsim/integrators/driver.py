@@ -47,7 +47,9 @@ def integrate(method, problem, y0, t0, t_end, t_out, options, y_out):
     to y_out[i] (exactly at t0 and t_end, by the method's dense output between
     steps).  Rows of y_out for times not reached are left untouched.  t_out = y_out =
     None: no output (the end state is returned), and Numba compiles this call without
-    the output code, dense output included (the sweeps' and plain runs' case).
+    the output code, dense output included.  Runs, their twins and sweeps all pass arrays
+    (empty ones for no output: the same steps and counts), so that a command compiles
+    one specialisation of this driver, which holds all the method's and model's code.
 
     Returns (status, t, y, counts, worst): counts (int64) = [accepted steps,
     rejected steps, RHS evaluations of the steps (dense output's are not counted), Jacobian

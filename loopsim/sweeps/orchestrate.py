@@ -166,7 +166,11 @@ def sweep(g0, theta0_deg, out, *, n="auto", seeds=1, method=None, t_end=DEFAULT_
         ``determined`` (``loopsim.outcomes``); run and twin together cost about 2.7 times the
         run alone (docs/auto-and-determinacy.md).
     early_stop : bool, default True
-        Stop a case once its shape and tilt are steady (docs/sweeps.md).
+        Stop a case once its shape and tilt are steady (``steady_tol`` per
+        ``steady_interval``; docs/sweeps.md): a sweep wants each case's terminal state,
+        not its states at later times.  :func:`loopsim.simulate` integrates to the end by
+        default instead (its ``steady_tol=None``): a single run returns its states at the
+        requested times.
     n_max : int, default 32
         With ``n="auto"``: the highest order a run may reach (also capped by the model's,
         for nonlocal).
