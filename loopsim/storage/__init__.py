@@ -14,7 +14,8 @@ re-exported here (``loopsim.storage.read_results`` and so on):
   which reads either kind.
 """
 from .integrity import (
-    CONTENT_KEY, DamagedFile, content_hash, read_table_checked, remove_stale_temporaries,
+    CONTENT_KEY, DamagedFile, content_hash, make_directories, read_table_checked,
+    remove_stale_temporaries,
     write_file_atomically, write_json_atomically, write_table_atomically,
 )
 from .sweepdir import (
@@ -38,6 +39,7 @@ __all__ = [
     "RUN_FIELDS", "SNAPSHOT_DIR", "SUMMARY_FIELDS", "SWEEP_FILE", "case_order",
     "check_files_belong", "check_layout", "check_no_overlap", "check_rows", "chunk_files",
     "coefficients", "config_fingerprint", "content_hash", "damaged_files", "described",
+    "make_directories",
     "overlapping", "provenance", "quarantine", "read_metadata", "read_results",
     "read_snapshots", "read_sweep_file", "read_table_checked", "remove_stale_temporaries",
     "requires_hash", "result_table", "table_metadata", "trajectory_table", "write_json_atomically",

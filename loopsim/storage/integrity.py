@@ -46,6 +46,27 @@ def remove_stale_temporaries(directory):
             pass
 
 
+def make_directories(path):
+    """``os.makedirs(path, exist_ok=True)`` without its recursion (one call per level: a
+    legal path 1 000 directories deep exhausted Python's stack): the missing directories
+    are made from the outermost in, each with the umask's mode.  FileExistsError where a
+    component is a file."""
+    path = os.path.abspath(os.fspath(path))
+    missing = []
+    while not os.path.isdir(path):
+        missing.append(path)
+        parent = os.path.dirname(path)
+        if parent == path:
+            break
+        path = parent
+    for directory in reversed(missing):
+        try:
+            os.mkdir(directory)
+        except FileExistsError:
+            if not os.path.isdir(directory):
+                raise
+
+
 def _umask():
     """The process umask (read without changing it where /proc allows)."""
     try:
@@ -67,7 +88,7 @@ def _temporary(directory, suffix):
     (``_signals.remove_temporaries``).  The directory is made if absent (output paths are
     checked before any work); the temporaries that dead processes left in it are removed
     first (:func:`remove_stale_temporaries`)."""
-    os.makedirs(directory, exist_ok=True)
+    make_directories(directory)
     remove_stale_temporaries(directory)
     fd, tmp = tempfile.mkstemp(prefix=_temporary_prefix(), suffix=suffix, dir=directory)
     track_temporary(tmp)

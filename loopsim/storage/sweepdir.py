@@ -15,7 +15,7 @@ import pandas as pd
 import pyarrow as pa
 
 from .. import columns
-from .integrity import CONTENT_KEY, DamagedFile, read_table_checked
+from .integrity import CONTENT_KEY, DamagedFile, make_directories, read_table_checked
 from .tables import MOTION_FIELDS, RESULT_SCHEMA, read_metadata
 
 
@@ -134,7 +134,7 @@ def quarantine(directory, path, reason):
     """Move a damaged file into ``directory/_quarantine/`` (never deleted: a user may want
     it) and warn in one line; False when it is gone already (moved by a twin sweep)."""
     target_dir = os.path.join(directory, QUARANTINE_DIR)
-    os.makedirs(target_dir, exist_ok=True)
+    make_directories(target_dir)
     stamp = datetime.datetime.now(datetime.timezone.utc).strftime("%Y%m%dT%H%M%S")
     name = os.path.relpath(path, directory).replace(os.sep, "-")  # _snapshots-chunk-...
     target = os.path.join(target_dir, f"{name}.{stamp}-{os.getpid()}")

@@ -100,7 +100,7 @@ def _merge_rerun(out, fingerprint, directory, attempt, rows):
     cases; a file already carrying ``attempt`` in its metadata is done (so a merge cut
     short by a kill resumes)."""
     replaced = os.path.join(directory, "replaced")
-    os.makedirs(replaced, exist_ok=True)
+    storage.make_directories(replaced)
     new = pa.Table.from_pandas(rows, schema=storage.RESULT_SCHEMA, preserve_index=False)
     by_id = set(rows["case_id"])
     for (start, stop), path in sorted(storage.chunk_files(out).items()):

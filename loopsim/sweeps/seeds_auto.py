@@ -72,7 +72,7 @@ def prepare(out, config, targets, command_line):
     while not os.path.exists(missing):
         made.insert(0, missing)
         missing = os.path.dirname(missing)
-    os.makedirs(out, exist_ok=True)
+    storage.make_directories(out)
     storage.write_json_atomically(dict(record, rounds=[], command_line=command_line or [],
                                   **json.loads(json.dumps(storage.provenance()))),
                              os.path.join(out, storage.SEEDS_FILE))
