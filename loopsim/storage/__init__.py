@@ -26,7 +26,8 @@ from .sweepdir import (
 )
 from .seedsdir import (
     CHECK_DIR, ROUND_DIR, SEEDS_FILE, STOPS_FILE, check_round_directory, check_rounds,
-    is_seeds_auto, read_results, read_seeds_auto, read_seeds_file, read_stop_table, round_directory,
+    is_seeds_auto, read_results, read_seeds_auto, read_seeds_file, read_stop_table, record_damage,
+    round_directory, seeds_record_hash, write_seeds_file,
 )
 from .tables import (
     COEFFICIENT_LAYOUT, INPUT_FIELDS, MOTION_FIELDS, OUTCOME_FIELDS, RESULT_SCHEMA, RUN_FIELDS, SUMMARY_FIELDS,
@@ -45,6 +46,7 @@ __all__ = [
     "requires_hash", "result_table", "table_metadata", "trajectory_table", "write_json_atomically",
     "CHECK_DIR", "ROUND_DIR", "SEEDS_FILE", "STOPS_FILE", "check_round_directory", "check_rounds",
     "is_seeds_auto", "read_seeds_auto",
-    "read_seeds_file", "read_stop_table", "round_directory",
+    "read_seeds_file", "read_stop_table", "record_damage", "round_directory",
+    "seeds_record_hash", "write_seeds_file",
     "write_file_atomically", "write_table_atomically", "write_trajectory",
 ]

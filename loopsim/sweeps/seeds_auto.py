@@ -14,6 +14,7 @@ the runs ``run_sweep``.
 import dataclasses
 import json
 import os
+import warnings
 
 import pandas as pd
 import pyarrow as pa
@@ -67,15 +68,18 @@ def prepare(out, config, targets, command_line):
         return []
     if os.path.isfile(os.path.join(out, storage.SWEEP_FILE)):
         raise ValueError(f"{out!r} holds a sweep with fixed --seeds; use another --out")
+    if os.path.isdir(storage.round_directory(out, 0)):
+        warnings.warn(f"{os.path.join(out, storage.SEEDS_FILE)!r} is missing although "
+                      f"{out!r} holds rounds: rebuilt from this command's options, each "
+                      "round checked against them as it resumes", stacklevel=2)
     made = []
     missing = os.path.abspath(out)
     while not os.path.exists(missing):
         made.insert(0, missing)
         missing = os.path.dirname(missing)
     storage.make_directories(out)
-    storage.write_json_atomically(dict(record, rounds=[], command_line=command_line or [],
-                                  **json.loads(json.dumps(storage.provenance()))),
-                             os.path.join(out, storage.SEEDS_FILE))
+    storage.write_seeds_file(out, dict(record, rounds=[], command_line=command_line or [],
+                                       **json.loads(json.dumps(storage.provenance()))))
     return made + [os.path.join(out, storage.SEEDS_FILE)]
 
 
@@ -102,7 +106,7 @@ def _record_round(out, index, fingerprint):
                              "changed); use another --out")
         return
     stored["rounds"] = rounds + [fingerprint]
-    storage.write_json_atomically(stored, os.path.join(out, storage.SEEDS_FILE))
+    storage.write_seeds_file(out, stored)
 
 
 def check_size(cells, targets):
@@ -275,6 +279,9 @@ def run_seeds_auto(config, out, targets, *, run_round, command_line=None, announ
         return storage.read_seeds_auto(out), storage.read_stop_table(out)
     rows = None
     index = 0
+    existing = 0  # rounds already there (a record rebuilt: :func:`prepare`)
+    while made and os.path.isdir(storage.round_directory(out, existing)):
+        existing += 1
     try:
         while True:
             cases = plan_round(cells, rows, targets, twins=config.twin)
@@ -293,8 +300,11 @@ def run_seeds_auto(config, out, targets, *, run_round, command_line=None, announ
                               expected_costs(cases, rows, config.twin)).assign(round=index)
             rows = frame if rows is None else pd.concat([rows, frame], ignore_index=True)
             index += 1
-    except BaseException:
-        if made and not os.path.isdir(storage.round_directory(out, 0)):
+    except BaseException as exc:
+        # a record made by this call goes again when it added no rows: a fresh
+        # directory's, or one rebuilt that a round already there refused (other options)
+        refused = isinstance(exc, ValueError) and index < existing
+        if made and (refused or not os.path.isdir(storage.round_directory(out, 0))):
             _undo(made)
         raise
     checks = None
