@@ -14,8 +14,8 @@ re-exported here (``loopsim.storage.read_results`` and so on):
   which reads either kind.
 """
 from .integrity import (
-    CONTENT_KEY, DamagedFile, content_hash, make_directories, read_table_checked,
-    remove_stale_temporaries,
+    CONTENT_KEY, DamagedFile, content_hash, make_directories, read_table_checked, record_hash,
+    record_hash_damage, remove_stale_temporaries, write_record_atomically,
     write_file_atomically, write_json_atomically, write_table_atomically,
 )
 from .sweepdir import (
@@ -27,7 +27,7 @@ from .sweepdir import (
 from .seedsdir import (
     CHECK_DIR, ROUND_DIR, SEEDS_FILE, STOPS_FILE, check_round_directory, check_rounds,
     is_seeds_auto, read_results, read_seeds_auto, read_seeds_file, read_stop_table, record_damage,
-    round_directory, seeds_record_hash, write_seeds_file,
+    round_directory, write_seeds_file,
 )
 from .tables import (
     COEFFICIENT_LAYOUT, INPUT_FIELDS, MOTION_FIELDS, OUTCOME_FIELDS, RESULT_SCHEMA, RUN_FIELDS, SUMMARY_FIELDS,
@@ -47,6 +47,6 @@ __all__ = [
     "CHECK_DIR", "ROUND_DIR", "SEEDS_FILE", "STOPS_FILE", "check_round_directory", "check_rounds",
     "is_seeds_auto", "read_seeds_auto",
     "read_seeds_file", "read_stop_table", "record_damage", "round_directory",
-    "seeds_record_hash", "write_seeds_file",
+    "write_seeds_file", "record_hash", "record_hash_damage", "write_record_atomically",
     "write_file_atomically", "write_table_atomically", "write_trajectory",
 ]

@@ -6,7 +6,6 @@ the fingerprints of its rounds; checksummed: :func:`write_seeds_file`), one
 ordinary sweep directory per round (:data:`ROUND_DIR`), and, once every cell has stopped,
 :data:`STOPS_FILE` (one row per cell: why it stopped).
 """
-import hashlib
 import json
 import os
 import re
@@ -14,7 +13,9 @@ import re
 import pandas as pd
 
 from . import sweepdir
-from .integrity import CONTENT_KEY, read_table_checked, write_json_atomically
+from .integrity import (
+    CONTENT_KEY, read_table_checked, record_hash_damage, write_record_atomically,
+)
 
 SEEDS_FILE = "_seeds_auto.json"
 STOPS_FILE = "seeds_auto.parquet"
@@ -41,40 +42,19 @@ _REBUILD_ADVICE = ("it holds the --seeds auto sweep's cells, targets and rounds:
                    "sweep's command with its options: it rebuilds the record and resumes")
 
 
-def seeds_record_hash(record):
-    """SHA-256 (hex) of a ``--seeds auto`` record (a dict) less its :data:`CONTENT_KEY`: what
-    :func:`write_seeds_file` stores under that key and :func:`read_seeds_file` checks."""
-    kept = {k: v for k, v in record.items() if k != CONTENT_KEY}
-    text = json.dumps(kept, sort_keys=True, separators=(",", ":"), ensure_ascii=True)
-    return hashlib.sha256(text.encode()).hexdigest()
-
-
 def write_seeds_file(out, record):
     """Write ``out``'s record (:data:`SEEDS_FILE`) atomically, with its checksum
-    (:func:`seeds_record_hash` under :data:`CONTENT_KEY`)."""
-    record = json.loads(json.dumps({k: v for k, v in record.items() if k != CONTENT_KEY}))
-    record[CONTENT_KEY] = seeds_record_hash(record)
-    write_json_atomically(record, os.path.join(out, SEEDS_FILE))
-
-
-def _one_off(name, key):
-    """Whether ``name`` is ``key`` with one character changed (a flipped bit in a key)."""
-    return len(name) == len(key) and sum(a != b for a, b in zip(name, key)) == 1
+    (``integrity.write_record_atomically``)."""
+    write_record_atomically(record, os.path.join(out, SEEDS_FILE))
 
 
 def record_damage(record):
     """Why a decoded ``--seeds auto`` record is damaged, or None: its checksum fails, or
     (a record of a release before checksums) a field it needs is missing or of the wrong
     kind, or its checksum's key is misspelt."""
-    if not isinstance(record, dict):
-        return f"a JSON {type(record).__name__}, not an object"
-    if CONTENT_KEY in record:
-        if record[CONTENT_KEY] != seeds_record_hash(record):
-            return "content does not match its checksum"
-        return None
-    misspelt = [k for k in record if _one_off(k, CONTENT_KEY)]
-    if misspelt:
-        return f"its checksum's key reads {misspelt[0]!r}"
+    damage = record_hash_damage(record)
+    if damage is not None or CONTENT_KEY in record:
+        return damage
     config, targets = record.get("config"), record.get("targets")
     if not isinstance(targets, dict):
         return "no 'targets'"

@@ -52,7 +52,7 @@ def prepare_directory(out, config, command_line):
     storage.remove_stale_temporaries(os.path.join(out, storage.SNAPSHOT_DIR))
     if stored is None:
         hashed = all(storage.CONTENT_KEY in storage.read_metadata(path) for path in files.values())
-        storage.write_json_atomically(dict(
+        storage.write_record_atomically(dict(
             layout=storage.LAYOUT, fingerprint=fingerprint, config=current,
             command_line=command_line,
             field_notes=FIELD_NOTES, reruns=[],

@@ -61,7 +61,7 @@ def rerun_failed(out, method, rtol, atol, **backend):
         open_attempt = dict(attempt=len(reruns) + 1, settings=settings, case_ids=failed,
                             merged=False)
         stored["reruns"] = reruns + [open_attempt]
-        storage.write_json_atomically(stored, os.path.join(out, storage.SWEEP_FILE))
+        storage.write_record_atomically(stored, os.path.join(out, storage.SWEEP_FILE))
     ids = open_attempt["case_ids"]
     directory = os.path.join(out, storage.RERUN_DIR, str(open_attempt["attempt"]))
     config = dataclasses.replace(base, cases=[base.cases[i] for i in ids], snapshots_for=[],
@@ -70,7 +70,7 @@ def rerun_failed(out, method, rtol, atol, **backend):
     _merge_rerun(out, stored["fingerprint"], directory, open_attempt["attempt"],
                  rerun.assign(case_id=[ids[i] for i in rerun["case_id"]]))
     open_attempt["merged"] = True
-    storage.write_json_atomically(stored, os.path.join(out, storage.SWEEP_FILE))
+    storage.write_record_atomically(stored, os.path.join(out, storage.SWEEP_FILE))
     return storage.read_results(out), len(ids)
 
 

@@ -1,5 +1,6 @@
-"""The ``--seeds auto`` record (``_seeds_auto.json``) is checksummed like every file loopsim
-writes (``storage.write_seeds_file``): a damaged one is a one-line error naming it in every
+"""The JSON records of a sweep directory (``_sweep.json``) and a ``--seeds auto`` directory
+(``_seeds_auto.json``) are checksummed like every file loopsim writes
+(``storage.write_record_atomically``): a damaged one is a one-line error naming it in every
 reader and command, and the advice given, followed (move it away, re-run the sweep's
 command), leads to a directory that resumes.  Issue 54.3: a renamed key gave a
 ``KeyError: 'cases'`` traceback; a flipped round fingerprint gave advice that wedged the
@@ -115,3 +116,35 @@ def test_a_record_of_a_release_before_checksums_still_reads_and_resumes(auto, ca
     storage.write_json_atomically(record, _record_path(auto))
     with pytest.raises(ValueError, match="damaged \\(no 'config' with its 'cases'\\)"):
         loopsim.read_results(auto)
+
+
+SWEEP = ["sweep", "--g0", "10,40", "--theta0", "30", "--n", "6", "--t-end", "0.05",
+         "--no-twin", "--threads", "1", "--quiet"]
+
+
+@pytest.mark.parametrize("field, old, new", [
+    ("checksums", '"checksums": "content_sha256"', '"checksums": "content_sha257"'),
+    ("loopsim_version", '"loopsim_version": "0.', '"loopsim_version": "1.'),
+    ("layout", '"layout": 2', '"layout": 3'),
+])
+def test_a_flip_outside_the_configuration_of_sweep_json_is_damage(tmp_path, capsys, field,
+                                                                   old, new):
+    """The fingerprint covers the configuration only: a flip in ``checksums`` (which says
+    whether result files must carry their hash), the versions or the layout went
+    unseen.  The advice, followed, rewrites the record and the sweep reads again."""
+    out = str(tmp_path / "s")
+    assert main(SWEEP + ["--out", out]) == 0
+    expected = loopsim.read_results(out)
+    path = os.path.join(out, storage.SWEEP_FILE)
+    with open(path) as handle:
+        text = handle.read()
+    assert old in text, field
+    with open(path, "w") as handle:
+        handle.write(text.replace(old, new, 1))
+    with pytest.raises(ValueError, match="damaged .content does not match its checksum"):
+        loopsim.read_results(out)
+    assert main(["summary", out]) == 2
+    assert "move it away" in _one_line_error(capsys)
+    os.replace(path, path + ".damaged")
+    assert main(SWEEP + ["--out", out]) == 0
+    pd.testing.assert_frame_equal(loopsim.read_results(out), expected)
