@@ -7,6 +7,7 @@ import pyarrow as pa
 
 from .. import refinement, storage, validation
 from ..outcomes import Thresholds
+from . import lock
 from .cases import SweepConfig
 from .orchestrate import run_sweep
 
@@ -28,18 +29,28 @@ def rerun_failed(out, method, rtol, atol, **backend):
     every result file holding those cases is rewritten with the new rows (its metadata
     lists the attempt) after the original was copied to ``out/_reruns/k/replaced/``.
     Returns (the results DataFrame, the number of cases rerun).  ``backend``: as for
-    :func:`run_sweep` (threads, quiet, scheduler, local_cluster, workers, ...).
+    :func:`run_sweep` (threads, quiet, scheduler, local_cluster, workers, ...).  The
+    directory is held (``lock``) throughout: refused while any sweep runs in it.
     """
     if method is not None:
         validation.check_choice("--method", method, refinement.METHOD_CHOICES)
     validation.check_real("--rtol", rtol, low=0.0, low_open=True)  # before anything is
     validation.check_real("--atol", atol, low=0.0)  # recorded: a refused rerun leaves no trace
     if os.path.isdir(out) and storage.is_seeds_auto(out):
-        return _rerun_rounds(out, method, rtol, atol, **backend)
+        with lock.acquire(out, lock.holder(None, exclusive=True)):
+            return _rerun_rounds(out, method, rtol, atol, **backend)
     stored = storage.read_sweep_file(out) if os.path.isdir(out) else None
     if stored is None:
         raise ValueError(f"no sweep at {out!r} (no {storage.SWEEP_FILE}) to rerun failed cases of")
     storage.check_layout(out)
+    with lock.acquire(out, lock.holder(stored["fingerprint"], exclusive=True)):
+        stored = storage.read_sweep_file(out)  # as it is now that no one else writes it
+        return _rerun_sweep(out, stored, method, rtol, atol, **backend)
+
+
+def _rerun_sweep(out, stored, method, rtol, atol, **backend):
+    """:func:`rerun_failed` on the sweep directory ``out`` (its decoded ``_sweep.json``:
+    ``stored``), held by this command."""
     base = config_from_dict(stored["config"])
     settings = dict(method=method or base.method, rtol=rtol, atol=atol)
     reruns = stored.get("reruns", [])

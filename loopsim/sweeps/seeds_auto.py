@@ -22,6 +22,7 @@ import pyarrow as pa
 from .. import (
     columns, outcome_statistics, outcomes, seeds_auto_rule, storage, validation,
 )
+from . import lock
 from .cases import validate
 
 #: The inputs that tell the cells apart (the seed never does).  Every other input of a
@@ -55,9 +56,10 @@ def _differences(stored, record):
 
 
 def prepare(out, config, targets, command_line):
-    """Make ``out`` for this ``--seeds auto`` sweep, or check that it holds this very one
-    (the same cells, targets and options, the chunk size aside); a one-line ValueError
-    otherwise.  Returns what it made (paths, deepest last) for :func:`_undo`."""
+    """Write the record of this ``--seeds auto`` sweep into the directory ``out``, or check
+    that it holds this very one (the same cells, targets and options, the chunk size
+    aside); a one-line ValueError otherwise.  Returns what it made (the record, or
+    nothing) for :func:`_undo`."""
     record = _record(config, targets)
     stored = storage.read_seeds_file(out)
     if stored is not None:
@@ -72,20 +74,33 @@ def prepare(out, config, targets, command_line):
         warnings.warn(f"{os.path.join(out, storage.SEEDS_FILE)!r} is missing although "
                       f"{out!r} holds rounds: rebuilt from this command's options, each "
                       "round checked against them as it resumes", stacklevel=2)
+    storage.write_seeds_file(out, dict(record, rounds=[], command_line=command_line or [],
+                                       **json.loads(json.dumps(storage.provenance()))))
+    return [os.path.join(out, storage.SEEDS_FILE)]
+
+
+def _make_directory(out):
+    """Make ``out`` if absent; the directories made, outermost first (for :func:`_undo`)."""
     made = []
     missing = os.path.abspath(out)
     while not os.path.exists(missing):
         made.insert(0, missing)
         missing = os.path.dirname(missing)
     storage.make_directories(out)
-    storage.write_seeds_file(out, dict(record, rounds=[], command_line=command_line or [],
-                                       **json.loads(json.dumps(storage.provenance()))))
-    return made + [os.path.join(out, storage.SEEDS_FILE)]
+    return made
+
+
+def _fingerprint(config, targets):
+    """What a ``--seeds auto`` sweep computes, as a fingerprint (``storage.config_fingerprint``
+    of its options and targets; the chunk size aside): the directory's holder records it."""
+    return storage.config_fingerprint(dict(json.loads(json.dumps(config.as_dict())),
+                                           seeds_auto_targets=dataclasses.asdict(targets)))
 
 
 def _undo(made):
-    """Remove what :func:`prepare` made (its record, then the directories it made, if
-    empty): a command refused before its first round leaves the file system as it was."""
+    """Remove what :func:`prepare` made (its record) or :func:`_make_directory` (the
+    directories, if empty): a command refused before its first round leaves the file
+    system as it was."""
     for path in reversed(made):
         try:
             os.remove(path) if os.path.isfile(path) else os.rmdir(path)
@@ -274,6 +289,17 @@ def run_seeds_auto(config, out, targets, *, run_round, command_line=None, announ
     cells = [dict(case, seed=0) for case in config.cases]
     validate(dataclasses.replace(config, cases=cells))  # distinct cells among the rest
     check_size(cells, targets)
+    directories = _make_directory(out)
+    try:
+        with lock.acquire(out, lock.holder(_fingerprint(config, targets)), command_line):
+            return _run_rounds(config, out, targets, cells, run_round, command_line, announce)
+    except BaseException:
+        _undo(directories)  # those this call made, if empty (the record is gone with them)
+        raise
+
+
+def _run_rounds(config, out, targets, cells, run_round, command_line, announce):
+    """:func:`run_seeds_auto` in the directory ``out``, held by this command."""
     made = prepare(out, config, targets, command_line)
     if not made and os.path.isfile(os.path.join(out, storage.STOPS_FILE)):
         return storage.read_seeds_auto(out), storage.read_stop_table(out)
