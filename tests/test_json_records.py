@@ -148,3 +148,22 @@ def test_a_flip_outside_the_configuration_of_sweep_json_is_damage(tmp_path, caps
     os.replace(path, path + ".damaged")
     assert main(SWEEP + ["--out", out]) == 0
     pd.testing.assert_frame_equal(loopsim.read_results(out), expected)
+
+
+def test_a_damaged_round_record_of_a_finished_directory_resumes_as_advised(auto, capsys):
+    """A round's ``_sweep.json`` damaged in a finished ``--seeds auto`` directory: its
+    advice (move it away, re-run the sweep's command) used to leave a round with result
+    files and no configuration, which the finished directory's command read back
+    without restoring."""
+    expected = loopsim.read_results(auto)
+    path = os.path.join(storage.round_directory(auto, 0), storage.SWEEP_FILE)
+    with open(path) as handle:
+        text = handle.read()
+    with open(path, "w") as handle:
+        handle.write(text.replace('"t_end": 0.05', '"t_end": 0.06', 1))
+    assert main(AUTO + ["--out", auto]) == 2
+    assert "move it away" in _one_line_error(capsys)
+    os.replace(path, path + ".damaged")
+    assert main(AUTO + ["--out", auto]) == 0
+    columns = [c for c in expected.columns if c != "wall_s"]
+    pd.testing.assert_frame_equal(loopsim.read_results(auto)[columns], expected[columns])

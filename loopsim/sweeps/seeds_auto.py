@@ -108,6 +108,18 @@ def _undo(made):
             return
 
 
+def _round_record_missing(out):
+    """Whether a round directory of ``out`` has lost its ``_sweep.json`` (moved away as its
+    damage advised): the rounds are then planned again, and each resumes and rewrites it."""
+    index = 0
+    while os.path.isdir(storage.round_directory(out, index)):
+        if not os.path.isfile(os.path.join(storage.round_directory(out, index),
+                                           storage.SWEEP_FILE)):
+            return True
+        index += 1
+    return False
+
+
 def _record_round(out, index, fingerprint):
     """Record round ``index``'s fingerprint in the directory's record before it runs; a
     ValueError if another one is recorded there (its rows would not be this sweep's)."""
@@ -283,7 +295,9 @@ def run_seeds_auto(config, out, targets, *, run_round, command_line=None, announ
     runs at all) and the stop table records the verdicts.
     Every input is checked before anything is written; a command that fails before its
     first round leaves nothing behind.  A finished directory (its stop table written) is
-    read back, not planned again (a ``--rerun-failed`` may have replaced failed rows).
+    read back, not planned again (a ``--rerun-failed`` may have replaced failed rows),
+    unless a round has lost its ``_sweep.json``: planned again, the rounds resume and the
+    lost file is rewritten (a round whose rows a rerun changed may then be refused).
     """
     targets.check()
     cells = [dict(case, seed=0) for case in config.cases]
@@ -301,7 +315,8 @@ def run_seeds_auto(config, out, targets, *, run_round, command_line=None, announ
 def _run_rounds(config, out, targets, cells, run_round, command_line, announce):
     """:func:`run_seeds_auto` in the directory ``out``, held by this command."""
     made = prepare(out, config, targets, command_line)
-    if not made and os.path.isfile(os.path.join(out, storage.STOPS_FILE)):
+    if (not made and os.path.isfile(os.path.join(out, storage.STOPS_FILE))
+            and not _round_record_missing(out)):
         return storage.read_seeds_auto(out), storage.read_stop_table(out)
     rows = None
     index = 0
