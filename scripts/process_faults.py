@@ -31,9 +31,12 @@ import loopsim
 from loopsim import storage
 from loopsim.exit_codes import EXIT_BROKEN_PIPE
 
-SWEEP = [sys.executable, "-m", "loopsim", "sweep", "--g0", "10,60,120", "--theta0", "30,60",
-         "--n", "6", "--t-end", "3", "--no-twin", "--threads", "1", "--chunk-size", "1",
-         "--quiet"]
+#: The sweep every scenario runs (``--out`` appended); with progress lines on stderr (not
+#: --quiet) where the streams are the fault.
+LOUD_SWEEP = [sys.executable, "-m", "loopsim", "sweep", "--g0", "10,60,120", "--theta0",
+              "30,60", "--n", "6", "--t-end", "3", "--no-twin", "--threads", "1",
+              "--chunk-size", "1"]
+SWEEP = LOUD_SWEEP + ["--quiet"]
 
 
 def _start(argv, **streams):
@@ -112,14 +115,14 @@ def _close_fds(*fds):
 
 def stderr_closed(root):
     out = os.path.join(root, "stderr-closed")
-    process = _start(SWEEP + ["--progress-every", "0.001", "--out", out], stderr=None,
+    process = _start(LOUD_SWEEP + ["--progress-every", "0.001", "--out", out], stderr=None,
                      preexec_fn=_close_fds(2))
     return _finish([process])[0][0] == 0 and _reads_whole(out)
 
 
 def stderr_reader_gone(root):
     out = os.path.join(root, "stderr-gone")
-    process = _start(SWEEP + ["--progress-every", "0.001", "--out", out])
+    process = _start(LOUD_SWEEP + ["--progress-every", "0.001", "--out", out])
     process.stderr.close()
     process.stdout.read()
     return process.wait(timeout=600) == 0 and _reads_whole(out)

@@ -8,6 +8,7 @@ import sys
 import pytest
 
 import loopsim
+from loopsim import storage
 from loopsim.exit_codes import EXIT_BROKEN_PIPE
 
 SWEEP = ["sweep", "--g0", "10,40", "--theta0", "30", "--n", "6", "--t-end", "0.05",
@@ -39,7 +40,8 @@ def test_sweep_with_closed_or_broken_stderr_does_its_work(tmp_path, how):
 
 def test_run_with_every_standard_stream_closed_writes_its_file(tmp_path):
     """stdin, stdout and stderr all closed: the files the program opens must not take
-    their numbers (a later write to fd 2 would land in a data file)."""
+    their numbers (a later write to fd 2 would land in a data file).  A guard: this one
+    passed before issue 54 too."""
     out = tmp_path / "run.parquet"
 
     def close_all():
@@ -49,7 +51,7 @@ def test_run_with_every_standard_stream_closed_writes_its_file(tmp_path):
     process = _loopsim(["run", "--g0", "10", "--theta0", "30", "--n", "6", "--t-end", "0.05",
                         "--out", str(out)], preexec_fn=close_all)  # noqa: PLW1509
     assert process.wait(timeout=300) == 0
-    assert len(loopsim.storage.read_table_checked(str(out), True)) > 0
+    assert len(storage.read_table_checked(str(out), True)) > 0
 
 
 def test_summary_into_a_pipe_whose_reader_has_gone_exits_quietly(tmp_path):
