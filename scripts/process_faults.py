@@ -33,9 +33,11 @@ from loopsim.exit_codes import EXIT_BROKEN_PIPE
 
 #: The sweep every scenario runs (``--out`` appended); with progress lines on stderr (not
 #: --quiet) where the streams are the fault.
-LOUD_SWEEP = [sys.executable, "-m", "loopsim", "sweep", "--g0", "10,60,120", "--theta0",
-              "30,60", "--n", "6", "--t-end", "3", "--no-twin", "--threads", "1",
+LOUD_SWEEP = [sys.executable, "-m", "loopsim", "sweep", "--g0", "10,60,120,200", "--theta0",
+              "30,60,80", "--n", "6", "--t-end", "6", "--no-twin", "--threads", "1",
               "--chunk-size", "1"]
+#: Its cases (2-3 s of work: a start finds the other still running after loading).
+CASES = 12
 SWEEP = LOUD_SWEEP + ["--quiet"]
 
 
@@ -53,7 +55,7 @@ def _finish(processes):
     return results
 
 
-def _reads_whole(out, cases=6):
+def _reads_whole(out, cases=CASES):
     try:
         return len(loopsim.read_results(out)) == cases
     except ValueError:

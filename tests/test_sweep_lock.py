@@ -120,9 +120,10 @@ def test_two_different_sweeps_started_at_once_into_a_new_directory(tmp_path):
     """Real processes, started together: exactly one runs, the other is refused at once
     with one line naming the holder; the directory is the winner's, whole."""
     out = str(tmp_path / "new")
-    base = [sys.executable, "-m", "loopsim", "sweep", "--g0", "10,60,120", "--theta0", "30,60",
-            "--n", "6", "--t-end", "3", "--no-twin", "--threads", "1", "--chunk-size", "1",
-            "--quiet", "--out", out]
+    # 12 cases, 3-5 s of work: the winner still runs when the other has loaded (2-3 s)
+    base = [sys.executable, "-m", "loopsim", "sweep", "--g0", "10,60,120,200", "--theta0",
+            "30,60,80", "--n", "6", "--t-end", "10", "--no-twin", "--threads", "1",
+            "--chunk-size", "1", "--quiet", "--out", out]
     processes = [subprocess.Popen(base + extra, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
                                   text=True) for extra in ([], ["--rtol", "1e-5"])]
     results = [p.communicate(timeout=300) + (p.returncode,) for p in processes]
@@ -133,7 +134,7 @@ def test_two_different_sweeps_started_at_once_into_a_new_directory(tmp_path):
     winner = processes[[r[2] for r in results].index(0)]
     assert f"pid {winner.pid} " in loser[1]
     frame = loopsim.read_results(out)
-    assert len(frame) == 6 and frame["rtol"].nunique() == 1
+    assert len(frame) == 12 and frame["rtol"].nunique() == 1
     stored = storage.read_sweep_file(out)
     assert stored["config"]["rtol"] == frame["rtol"].iloc[0]
 
