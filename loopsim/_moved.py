@@ -5,7 +5,8 @@ No file is left at an old path: an import of one is answered by :class:`MovedFin
 (on ``sys.meta_path`` from ``import loopsim`` on) with the new module itself, so
 ``loopsim.summary.summarize is loopsim.outcome_statistics.summarize``.  A package's
 submodules follow it (``loopsim.io.tables`` is ``loopsim.storage.tables``).
-``loopsim.config``, split three ways, is a module that looks each name up in the three.
+``loopsim.config``, split three ways, is a module that looks each name up in the three
+(its ``__all__``, the names it had, makes ``from loopsim.config import *`` give them).
 Plain Python: importing this module loads neither NumPy nor Numba.
 """
 import importlib
@@ -25,6 +26,18 @@ MOVED = {
     "loopsim.stability.circle": ("loopsim.stability.full_linear",),
     "loopsim.models.nonlocal_circle": ("loopsim.models.nonlocal_closed_form",),
     "loopsim.config": ("loopsim.defaults", "loopsim.jit", "loopsim.exit_codes"),
+}
+
+#: The public names of the split modules as they were (what ``from loopsim.config import *``
+#: gave): a split module has no dictionary of its own to take them from.
+OLD_PUBLIC_NAMES = {
+    "loopsim.config": (
+        "JIT", "ENVIRONMENT_ERRNOS", "DEFAULT_W", "DEFAULT_N", "DEFAULT_T_END", "DEFAULT_RTOL",
+        "DEFAULT_ATOL", "DEFAULT_PERTURBATION", "DEFAULT_SEED", "DEFAULT_MAX_STEPS",
+        "DEFAULT_CHUNK_SIZE", "DEFAULT_AUTO_CHUNK_SIZE", "DEFAULT_LENGTH_TOL",
+        "DEFAULT_STEADY_INTERVAL", "DEFAULT_STEADY_TOL", "RESOLVED_LENGTH_ERROR",
+        "RESOLVED_TAIL", "DEFORMATION_FLOOR", "AUTO_ORDERS", "DEFAULT_N_MAX", "MODEL_CHOICES",
+        "MAX_SLENDERNESS", "DEFAULT_TAIL_TOL", "INITIAL_CONTENT_TOL", "SEED_TARGETS"),
 }
 
 
@@ -73,6 +86,7 @@ class MovedFinder(importlib.abc.MetaPathFinder, importlib.abc.Loader):
             raise AttributeError(f"module {name!r} has no attribute {attribute!r}")
 
         module.__getattr__ = look_up
+        module.__all__ = list(OLD_PUBLIC_NAMES[name])  # ``import *`` looks each one up
 
 
 def install():

@@ -1,6 +1,7 @@
 """Fault injection (issue 14): damaged result files (truncated, zero length, a flipped bit)
 are detected, moved aside and recomputed; damaged --initial results are refused; sizes
 are bounded before any work; Ctrl-C on ``loopsim run``; temporaries of killed runs."""
+import json
 import os
 import shutil
 import signal
@@ -581,11 +582,18 @@ def test_the_next_write_removes_temporaries_of_dead_writers(tmp_path, capsys):
 
 
 def test_edited_sweep_file_is_damaged(sweep):
-    """A flipped value in _sweep.json's configuration no longer matches its fingerprint."""
+    """A flipped value in _sweep.json's configuration no longer matches its checksum, nor,
+    in a record of a release before whole-record checksums, its fingerprint."""
     path = os.path.join(sweep, storage.SWEEP_FILE)
     text = open(path).read()
     assert '"t_end": 0.2' in text
     open(path, "w").write(text.replace('"t_end": 0.2', '"t_end": 0.3'))
+    with pytest.raises(ValueError, match="_sweep.json' is damaged .content does not match its "
+                                         "checksum"):
+        loopsim.read_results(sweep)
+    older = json.loads(open(path).read())
+    del older[storage.CONTENT_KEY]
+    storage.write_json_atomically(older, path)
     with pytest.raises(ValueError, match="_sweep.json' is damaged.*fingerprint"):
         loopsim.read_results(sweep)
 

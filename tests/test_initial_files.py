@@ -289,3 +289,32 @@ def test_a_cases_file_point_row_with_n_auto_starts_at_its_content_order(tmp_path
     assert order > 6 and loopsim.read_results(out)["n"].tolist() == [order]
     fixed = sweeps.read_cases_file(str(cases), n=8)  # no --n auto: the given order
     assert fixed[0]["n"] == 8
+
+
+@pytest.mark.parametrize("size", [1e-300, 1e-200, 1e154, 1e300])
+def test_point_files_at_extreme_scales_fit_as_at_unit_scale(tmp_path, rng, size):
+    """The model is scale-free (the loop is rescaled to length 2π): a file's curve at
+    1e300 or 1e-300 gives the shape the same curve at size 1 gives, and the length and
+    scale in the file's units.  Issue 54.10: near 1e154 and 1e300 scipy's "value of p too
+    large", near 1e-300 "points 0 and 1 coincide"."""
+    s = uneven(150, rng)
+    points = np.stack([np.sin(s) + 0.2 * np.sin(2 * s), 0.8 * np.cos(s),
+                       0.3 * np.cos(s) + 0.1 * np.sin(3 * s)], axis=1) + [0.5, -0.25, 1.0]
+    unit, unit_info = shapes.load_initial(write_points(tmp_path / "unit.csv", points), 8)
+    x, info = shapes.load_initial(write_points(tmp_path / "scaled.csv", points * size), 8)
+    assert np.max(np.abs(x - unit)) < 1e-9  # measured 0.7e-15 to 2.1e-15
+    assert info["length"] == pytest.approx(unit_info["length"] * size, rel=1e-9)
+    assert info["scale"] == pytest.approx(unit_info["scale"] / size, rel=1e-9)
+    assert info["tilt_deg"] == pytest.approx(unit_info["tilt_deg"], abs=1e-9)
+
+
+@pytest.mark.parametrize("size, reason", [(1e-310, "below"), (1e308, "beyond what a double")])
+def test_point_files_beyond_a_doubles_range_say_so(tmp_path, rng, size, reason):
+    """Coordinates all subnormal (too few digits), or a curve whose length in the file's
+    units overflows: "scale out of range", one line, naming the file."""
+    s = uneven(40, rng)
+    points = np.stack([np.sin(s), np.cos(s), 0.2 * np.cos(s)], axis=1) * size
+    path = write_points(tmp_path / "p.csv", points)
+    with pytest.raises(ValueError, match="scale out of range") as caught:
+        shapes.load_initial(path, 6)
+    assert reason in str(caught.value) and "\n" not in str(caught.value)

@@ -63,3 +63,24 @@ def test_the_command_line_loads_the_finder_without_numpy():
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                           check=True)
     assert done.stdout.strip() == "False"
+
+
+@pytest.mark.parametrize("old", sorted(_moved.MOVED) + ["loopsim.io.tables", "loopsim.ensemble"])
+def test_star_import_of_an_old_path_gives_its_public_names_and_warns(old):
+    """``from OLD import *`` warns and binds the old public names, each the new object
+    (issue 54.12: ``from loopsim.config import *`` bound none)."""
+    sys.modules.pop(old, None)
+    namespace = {}
+    with pytest.warns(DeprecationWarning, match=old.replace(".", r"\.")):
+        exec(f"from {old} import *", namespace)  # noqa: S102 - the statement under test
+    names = {key for key in namespace if not key.startswith("__")}
+    if old in _moved.OLD_PUBLIC_NAMES:
+        assert names == set(_moved.OLD_PUBLIC_NAMES[old])
+        from loopsim import defaults, exit_codes, jit
+
+        assert namespace["DEFAULT_W"] is defaults.DEFAULT_W
+        assert namespace["SEED_TARGETS"] is defaults.SEED_TARGETS
+        assert namespace["ENVIRONMENT_ERRNOS"] is exit_codes.ENVIRONMENT_ERRNOS
+        assert namespace["JIT"] is jit.JIT
+    else:
+        assert names, f"from {old} import * bound nothing"

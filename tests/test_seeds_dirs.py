@@ -100,9 +100,10 @@ def test_a_round_copied_in_from_another_sweep_is_refused_on_read(auto, tmp_path,
         loopsim.read_results(auto)
     assert main(["summary", auto]) == 2
     assert "round-00" in capsys.readouterr().err
-    # a directory recorded before round fingerprints were: its options are compared
+    # a directory recorded before round fingerprints (and checksums) were: its options
+    # are compared
     record = storage.read_seeds_file(auto)
-    del record["rounds"]
+    del record["rounds"], record[storage.CONTENT_KEY]
     storage.write_json_atomically(record, os.path.join(auto, storage.SEEDS_FILE))
     with pytest.raises(ValueError, match="is not a round of the --seeds auto sweep"):
         loopsim.read_results(auto)

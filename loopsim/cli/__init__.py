@@ -3,7 +3,8 @@
 Errors in the input end with one line ``loopsim: error: ...`` on stderr and
 exit status 2; a run that fails numerically exits 1 after printing its summary; the
 machine refusing to go on (disk full, read-only filesystem, I/O error, a file-size
-limit) exits 3
+limit) exits 3; stdout's reader gone (``| head -1``) ends a command quietly with exit
+status 141, as a Unix tool ended by SIGPIPE (``exit_codes.EXIT_BROKEN_PIPE``)
 (``common.EXIT_CODES``; docs/cli.md is generated from these parsers by
 scripts/cli_reference.py).
 
@@ -19,7 +20,8 @@ import textwrap
 import warnings
 
 from .._version import __version__
-from ..exit_codes import ENVIRONMENT_ERRNOS
+from .._signals import stdout_gone
+from ..exit_codes import ENVIRONMENT_ERRNOS, EXIT_BROKEN_PIPE
 from . import (animate, branch, compare, figures, report, rest_window, run, stability, summary,
                sweep)
 from .common import EXIT_ENVIRONMENT, EXIT_EPILOG, EXIT_FAILED_RUN, EXIT_USAGE, METHODS, Parser
@@ -82,8 +84,12 @@ def main(argv=None):
     args = parser.parse_args(argv)
     try:
         with _one_line_warnings():
-            return COMMANDS[args.command].command(args)
+            status = COMMANDS[args.command].command(args)
+            sys.stdout.flush()  # here, not at exit: a reader gone is seen below
+            return status
     except (ValueError, OSError) as exc:
+        if isinstance(exc, BrokenPipeError) and stdout_gone():  # `| head -1`: stop quietly
+            return EXIT_BROKEN_PIPE
         print(f"loopsim: error: {exc}", file=sys.stderr)
         if isinstance(exc, OSError) and exc.errno in ENVIRONMENT_ERRNOS:  # the machine's fault
             return EXIT_ENVIRONMENT

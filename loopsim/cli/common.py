@@ -9,6 +9,7 @@ from ..defaults import (
     DEFAULT_ATOL, DEFAULT_N, DEFAULT_N_MAX, DEFAULT_PERTURBATION, DEFAULT_RTOL, DEFAULT_T_END,
     DEFAULT_TAIL_TOL, DEFAULT_W, MAX_SLENDERNESS, MODEL_CHOICES,
 )
+from ..exit_codes import EXIT_BROKEN_PIPE
 
 
 #: The integrators' names (``loopsim.integrators.METHODS``, tested equal): named here so
@@ -29,6 +30,8 @@ EXIT_CODES = (
                        "no memory or file handles left, a file-size limit reached (re-run "
                        "once fixed: sweeps resume)"),
     (130, "stopped by SIGINT (Ctrl-C: a sweep keeps its finished cases)"),
+    (EXIT_BROKEN_PIPE, "stdout's reader went away (a pipe into head): the output stops "
+                       "there, without a message, as a Unix tool ended by SIGPIPE"),
     (143, "stopped by SIGTERM (as 130)"),
 )
 #: The epilog of every command's --help: the exit statuses in one paragraph.

@@ -4,7 +4,7 @@ import os
 import numpy as np
 import pandas as pd
 
-from .. import validation
+from .. import storage, validation
 from ..stability.branch import steady_branch
 from .evolution import evolution, evolution_rows, tension_figure
 from .gallery import gallery
@@ -103,7 +103,7 @@ def write_figures(sweep_dir, others=(), out=".", only=None, gallery_theta0=30.0,
         raise ValueError(f"no sweep directory at {sweep_dir!r}")
     main = read_sweep(sweep_dir)
     sweeps, runs = _read_others(others)
-    os.makedirs(out, exist_ok=True)
+    storage.make_directories(out)
     written = {}
 
     def save(name, fig):

@@ -17,6 +17,10 @@ not repeating the first, spacing free, into model coefficients:
    integrated exactly; σ(τ) is inverted by Newton's method at equispaced arc
    length and f is resampled there: the fine shape g(s) of order N = max(2K, n)
    is parametrised by arc length starting from the first point.
+0. Unit size.  The points are multiplied by a power of two (exact) that brings the
+   largest |coordinate| into [0.5, 1), so that coordinates near 1e300 or 1e-300 fit as
+   those near 1 do (the model is scale-free); lengths and the scale are reported in the
+   file's units, and a file whose length or scale a double cannot hold is refused.
 4. Scale and truncate.  g is truncated to order n (``spectral.resize``) and
    the whole shape (mean included) is multiplied by ``scale`` so its length
    is 2π: ``x_model = scale * x_file``; ``scale = 2π / L`` up to the length
@@ -209,12 +213,48 @@ def _reparametrise(c, order):
     return _fft_fit(spectral.evaluate(c, tau)), float(length)
 
 
+def unit_exponent(points, source="points"):
+    """The power of two e that brings the largest |coordinate| of ``points`` into
+    [0.5, 1): the fit works on ``points * 2**-e`` (exact: only the exponents change), since
+    the model is scale-free (the shape is rescaled to length 2π) and squared distances of
+    coordinates near 1e154 overflow, near 1e-160 underflow.  A one-line ValueError for
+    coordinates that are all zero or subnormal (below 2.2e-308: too few digits left)."""
+    largest = float(np.max(np.abs(points))) if points.size else 0.0
+    if largest < np.finfo(float).tiny:
+        raise ValueError(f"{source}: every coordinate is below {np.finfo(float).tiny:.3g} in "
+                         f"size (largest {largest:.3g}): scale out of range, too few digits "
+                         "left to fit a curve; scale the file's coordinates up")
+    return math.frexp(largest)[1]
+
+
+def _in_file_units(value, exponent, what, source):
+    """``value * 2**exponent`` (a length or scale of the fit in the file's units), or a
+    one-line ValueError where a double cannot hold it."""
+    try:
+        result = math.ldexp(value, exponent)
+    except OverflowError:
+        result = math.inf
+    if not (math.isfinite(result) and result >= np.finfo(float).tiny):
+        raise ValueError(f"{source}: scale out of range: the curve's {what} in the file's "
+                         f"units ({value:.6g} x 2^{exponent}) is beyond what a double holds; "
+                         "scale the file's coordinates towards 1")
+    return result
+
+
 def fit_points(points, n, source="points"):
     """Order-n coefficients (3, 2n+1) of the closed curve through ``points`` (m, 3), the
-    fine arc-length series before truncation, and a dict of fit diagnostics (module doc)."""
+    fine arc-length series before truncation, and a dict of fit diagnostics (module doc).
+    The points are first brought to unit size by a power of two (:func:`unit_exponent`),
+    so that any finite scale fits alike; ``info``'s length and scale are in the file's
+    units, ``fine`` is at that unit size (what it is used for, its modes' shares, is the
+    same at any size)."""
     points = np.asarray(points, dtype=float)
     if points.ndim != 2 or points.shape[1] != 3:
         raise ValueError(f"{source}: points must have shape (m, 3), got {points.shape}")
+    if not np.all(np.isfinite(points)):
+        raise ValueError(f"{source}: non-finite coordinates")
+    exponent = unit_exponent(points, source)
+    points = np.ldexp(points, -exponent)
     check_points(points, n, source)
     tau, _ = _arc_length_nodes(points)
     f = _weighted_fit(tau, points)
@@ -224,7 +264,8 @@ def fit_points(points, n, source="points"):
     x = spectral.resize(fine, n)
     scale = 2.0 * np.pi / diagnostics.curve_length(x)
     x *= scale
-    info = dict(kind="points", source=source, points=int(len(points)), length=length,
-                scale=float(scale), fit_order=int(fit_order),
-                fit_residual=float(residual / length))
+    info = dict(kind="points", source=source, points=int(len(points)),
+                length=_in_file_units(length, exponent, "length", source),
+                scale=_in_file_units(scale, -exponent, "scale (2π over its length)", source),
+                fit_order=int(fit_order), fit_residual=float(residual / length))
     return x, fine, info

@@ -14,7 +14,8 @@ re-exported here (``loopsim.storage.read_results`` and so on):
   which reads either kind.
 """
 from .integrity import (
-    CONTENT_KEY, DamagedFile, content_hash, read_table_checked, remove_stale_temporaries,
+    CONTENT_KEY, DamagedFile, content_hash, make_directories, read_table_checked, record_hash,
+    record_hash_damage, remove_stale_temporaries, write_record_atomically,
     write_file_atomically, write_json_atomically, write_table_atomically,
 )
 from .sweepdir import (
@@ -25,7 +26,8 @@ from .sweepdir import (
 )
 from .seedsdir import (
     CHECK_DIR, ROUND_DIR, SEEDS_FILE, STOPS_FILE, check_round_directory, check_rounds,
-    is_seeds_auto, read_results, read_seeds_auto, read_seeds_file, read_stop_table, round_directory,
+    is_seeds_auto, read_results, read_seeds_auto, read_seeds_file, read_stop_table, record_damage,
+    round_directory, write_seeds_file,
 )
 from .tables import (
     COEFFICIENT_LAYOUT, INPUT_FIELDS, MOTION_FIELDS, OUTCOME_FIELDS, RESULT_SCHEMA, RUN_FIELDS, SUMMARY_FIELDS,
@@ -38,11 +40,13 @@ __all__ = [
     "RUN_FIELDS", "SNAPSHOT_DIR", "SUMMARY_FIELDS", "SWEEP_FILE", "case_order",
     "check_files_belong", "check_layout", "check_no_overlap", "check_rows", "chunk_files",
     "coefficients", "config_fingerprint", "content_hash", "damaged_files", "described",
+    "make_directories",
     "overlapping", "provenance", "quarantine", "read_metadata", "read_results",
     "read_snapshots", "read_sweep_file", "read_table_checked", "remove_stale_temporaries",
     "requires_hash", "result_table", "table_metadata", "trajectory_table", "write_json_atomically",
     "CHECK_DIR", "ROUND_DIR", "SEEDS_FILE", "STOPS_FILE", "check_round_directory", "check_rounds",
     "is_seeds_auto", "mixed_columns_text", "read_seeds_auto",
-    "read_seeds_file", "read_stop_table", "round_directory",
+    "read_seeds_file", "read_stop_table", "record_damage", "round_directory",
+    "write_seeds_file", "record_hash", "record_hash_damage", "write_record_atomically",
     "write_file_atomically", "write_table_atomically", "write_trajectory",
 ]

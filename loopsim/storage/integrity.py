@@ -46,6 +46,27 @@ def remove_stale_temporaries(directory):
             pass
 
 
+def make_directories(path):
+    """``os.makedirs(path, exist_ok=True)`` without its recursion (one call per level: a
+    legal path 1 000 directories deep exhausted Python's stack): the missing directories
+    are made from the outermost in, each with the umask's mode.  FileExistsError where a
+    component is a file."""
+    path = os.path.abspath(os.fspath(path))
+    missing = []
+    while not os.path.isdir(path):
+        missing.append(path)
+        parent = os.path.dirname(path)
+        if parent == path:
+            break
+        path = parent
+    for directory in reversed(missing):
+        try:
+            os.mkdir(directory)
+        except FileExistsError:
+            if not os.path.isdir(directory):
+                raise
+
+
 def _umask():
     """The process umask (read without changing it where /proc allows)."""
     try:
@@ -67,7 +88,7 @@ def _temporary(directory, suffix):
     (``_signals.remove_temporaries``).  The directory is made if absent (output paths are
     checked before any work); the temporaries that dead processes left in it are removed
     first (:func:`remove_stale_temporaries`)."""
-    os.makedirs(directory, exist_ok=True)
+    make_directories(directory)
     remove_stale_temporaries(directory)
     fd, tmp = tempfile.mkstemp(prefix=_temporary_prefix(), suffix=suffix, dir=directory)
     track_temporary(tmp)
@@ -161,6 +182,40 @@ def content_hash(table, metadata):
             digest.update(b"\0field " + key + b"\0" + value)
         _hash_array(digest, column.combine_chunks())
     return digest.hexdigest()
+
+
+def record_hash(record):
+    """SHA-256 (hex) of a JSON record (a dict: ``_sweep.json``, ``_seeds_auto.json``) less its
+    :data:`CONTENT_KEY`, over its canonical text (sorted keys, no spaces)."""
+    kept = {k: v for k, v in record.items() if k != CONTENT_KEY}
+    text = json.dumps(kept, sort_keys=True, separators=(",", ":"), ensure_ascii=True)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def write_record_atomically(record, path):
+    """Write a JSON record atomically with its checksum (:func:`record_hash` under
+    :data:`CONTENT_KEY`), checked by :func:`record_hash_damage` when read."""
+    record = json.loads(json.dumps({k: v for k, v in record.items() if k != CONTENT_KEY}))
+    record[CONTENT_KEY] = record_hash(record)
+    write_json_atomically(record, path)
+
+
+def _one_off(name, key):
+    """Whether ``name`` is ``key`` with one character changed (a flipped bit in a key)."""
+    return len(name) == len(key) and sum(a != b for a, b in zip(name, key)) == 1
+
+
+def record_hash_damage(record):
+    """Why a decoded JSON record fails its checksum, or None: not an object, a
+    :data:`CONTENT_KEY` that does not match, or that key misspelt.  None too for a record
+    without one (written by a release before checksums: its reader checks its fields)."""
+    if not isinstance(record, dict):
+        return f"a JSON {type(record).__name__}, not an object"
+    if CONTENT_KEY in record:
+        return None if record[CONTENT_KEY] == record_hash(record) else \
+            "content does not match its checksum"
+    misspelt = [k for k in record if _one_off(k, CONTENT_KEY)]
+    return f"its checksum's key reads {misspelt[0]!r}" if misspelt else None
 
 
 class DamagedFile(ValueError):

@@ -1,7 +1,8 @@
 """The ``--seeds auto`` directory (``sweeps.seeds_auto``): its layout, and its rounds' rows
 read as one table; :func:`read_results` reads either kind of directory.
 
-Layout: :data:`SEEDS_FILE` (the cells, the targets and the sweep's other options), one
+Layout: :data:`SEEDS_FILE` (the cells, the targets and the sweep's other options, and
+the fingerprints of its rounds; checksummed: :func:`write_seeds_file`), one
 ordinary sweep directory per round (:data:`ROUND_DIR`), and, once every cell has stopped,
 :data:`STOPS_FILE` (one row per cell: why it stopped).
 """
@@ -12,7 +13,9 @@ import re
 import pandas as pd
 
 from . import sweepdir
-from .integrity import read_table_checked
+from .integrity import (
+    CONTENT_KEY, read_table_checked, record_hash_damage, write_record_atomically,
+)
 
 SEEDS_FILE = "_seeds_auto.json"
 STOPS_FILE = "seeds_auto.parquet"
@@ -31,17 +34,57 @@ def round_directory(out, index):
     return os.path.join(out, ROUND_DIR.format(index))
 
 
+#: What a damaged or unreadable record tells the user to do: the sweep's own command
+#: rebuilds a missing record from its options, checking each round against it (a round
+#: planned with other options is refused), and resumes.
+_REBUILD_ADVICE = ("it holds the --seeds auto sweep's cells, targets and rounds: restore it "
+                   "from a copy, or move it away (to {path}.damaged, say) and re-run the "
+                   "sweep's command with its options: it rebuilds the record and resumes")
+
+
+def write_seeds_file(out, record):
+    """Write ``out``'s record (:data:`SEEDS_FILE`) atomically, with its checksum
+    (``integrity.write_record_atomically``)."""
+    write_record_atomically(record, os.path.join(out, SEEDS_FILE))
+
+
+def record_damage(record):
+    """Why a decoded ``--seeds auto`` record is damaged, or None: its checksum fails, or
+    (a record of a release before checksums) a field it needs is missing or of the wrong
+    kind, or its checksum's key is misspelt."""
+    damage = record_hash_damage(record)
+    if damage is not None or CONTENT_KEY in record:
+        return damage
+    config, targets = record.get("config"), record.get("targets")
+    if not isinstance(targets, dict):
+        return "no 'targets'"
+    if not isinstance(config, dict) or not isinstance(config.get("cases"), list) or not all(
+            isinstance(case, dict) for case in config["cases"]):
+        return "no 'config' with its 'cases'"
+    rounds = record.get("rounds", [])
+    if not isinstance(rounds, list) or not all(isinstance(r, str) for r in rounds):
+        return "'rounds' is not a list of fingerprints"
+    return None
+
+
 def read_seeds_file(out):
-    """The stored record of a ``--seeds auto`` directory (None if there is none)."""
+    """The stored record of a ``--seeds auto`` directory (None if there is none), checked
+    (:func:`record_damage`): a one-line ValueError naming the file and what to do when it
+    is unreadable or damaged."""
     path = os.path.join(out, SEEDS_FILE)
     if not os.path.isfile(path):
         return None
+    advice = _REBUILD_ADVICE.format(path=path)
     try:
         with open(path, encoding="utf-8") as handle:
-            return json.load(handle)
+            record = json.load(handle)
     except (OSError, ValueError) as exc:
-        raise ValueError(f"{path!r} is unreadable ({exc}); it holds the --seeds auto "
-                         "sweep's cells and targets: restore it or use another --out") from None
+        reason = str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__
+        raise ValueError(f"{path!r} is unreadable ({reason}); {advice}") from None
+    damage = record_damage(record)
+    if damage is not None:
+        raise ValueError(f"{path!r} is damaged ({damage}); {advice}")
+    return record
 
 
 def _without(config, keys):

@@ -15,7 +15,9 @@ import pandas as pd
 import pyarrow as pa
 
 from .. import columns
-from .integrity import CONTENT_KEY, DamagedFile, read_table_checked
+from .integrity import (
+    CONTENT_KEY, DamagedFile, make_directories, read_table_checked, record_hash_damage,
+)
 from .tables import MOTION_FIELDS, RESULT_SCHEMA, read_metadata
 
 
@@ -110,19 +112,26 @@ def overlapping(ranges):
 
 
 def read_sweep_file(directory):
-    """The decoded ``_sweep.json`` of a sweep directory, or None when there is none."""
+    """The decoded ``_sweep.json`` of a sweep directory, or None when there is none; a
+    one-line ValueError when it is damaged: its checksum (``content_sha256``, where the
+    record has one: older releases wrote none) or its fingerprint fails, or a field is
+    missing."""
     path = os.path.join(directory, SWEEP_FILE)
     if not os.path.exists(path):
         return None
     try:
         with open(path) as handle:
             stored = json.load(handle)
-        stored["fingerprint"], stored["config"]  # noqa: B018 - both must be there
-        if config_fingerprint(stored["config"]) != stored["fingerprint"]:
-            raise ValueError("its configuration does not match its fingerprint")
+        damage = record_hash_damage(stored)  # a whole-record checksum, where written
+        if damage is None:
+            stored["fingerprint"], stored["config"]  # noqa: B018 - both must be there
+            if config_fingerprint(stored["config"]) != stored["fingerprint"]:
+                damage = "its configuration does not match its fingerprint"
     except (ValueError, KeyError, TypeError, AttributeError) as exc:
-        raise ValueError(f"{path!r} is damaged ({type(exc).__name__}: {exc}); move it away and "
-                         "re-run the sweep's command to rewrite it") from None
+        damage = f"{type(exc).__name__}: {exc}"
+    if damage is not None:
+        raise ValueError(f"{path!r} is damaged ({damage}); move it away and re-run the "
+                         "sweep's command to rewrite it")
     return stored
 
 
@@ -134,7 +143,7 @@ def quarantine(directory, path, reason):
     """Move a damaged file into ``directory/_quarantine/`` (never deleted: a user may want
     it) and warn in one line; False when it is gone already (moved by a twin sweep)."""
     target_dir = os.path.join(directory, QUARANTINE_DIR)
-    os.makedirs(target_dir, exist_ok=True)
+    make_directories(target_dir)
     stamp = datetime.datetime.now(datetime.timezone.utc).strftime("%Y%m%dT%H%M%S")
     name = os.path.relpath(path, directory).replace(os.sep, "-")  # _snapshots-chunk-...
     target = os.path.join(target_dir, f"{name}.{stamp}-{os.getpid()}")

@@ -18,6 +18,7 @@ One module per job, each layer importing only those above it:
 * ``cases``: the configuration (:class:`SweepConfig`), grids, cases files, checks;
 * ``chunks``: positions, chunks and the pieces still to compute;
 * ``directory``: the sweep directory made, checked, repaired and written into;
+* ``lock``: one command at a time in a directory (shards of one sweep side by side);
 * ``runner``: a piece's cases integrated into rows (:func:`run_chunk`, :func:`run_piece`);
 * ``progress``: the progress line and its cost-weighted ETA;
 * ``signals``: SIGINT / SIGTERM as a stop flag (:class:`SweepInterrupted`);

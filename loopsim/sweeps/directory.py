@@ -17,7 +17,7 @@ def write_piece(out, fingerprint, piece, table, snapshots):
     meta = storage.provenance(sweep_fingerprint=fingerprint, positions=[piece.start, piece.stop])
     name = storage.CHUNK_PATTERN.format(piece.start, piece.stop)
     if snapshots is not None:
-        os.makedirs(os.path.join(out, storage.SNAPSHOT_DIR), exist_ok=True)
+        storage.make_directories(os.path.join(out, storage.SNAPSHOT_DIR))
         storage.write_table_atomically(snapshots.replace_schema_metadata(meta),
                                   os.path.join(out, storage.SNAPSHOT_DIR, name))
     storage.write_table_atomically(table.replace_schema_metadata(meta), os.path.join(out, name))
@@ -33,7 +33,7 @@ def prepare_directory(out, config, command_line):
     current = json.loads(json.dumps(config.as_dict()))
     fingerprint = storage.config_fingerprint(current)
     storage.check_round_directory(out, fingerprint)
-    os.makedirs(out, exist_ok=True)
+    storage.make_directories(out)
     stored = storage.read_sweep_file(out)
     if stored is not None and stored["fingerprint"] != fingerprint:
         previous = stored["config"]
@@ -52,7 +52,7 @@ def prepare_directory(out, config, command_line):
     storage.remove_stale_temporaries(os.path.join(out, storage.SNAPSHOT_DIR))
     if stored is None:
         hashed = all(storage.CONTENT_KEY in storage.read_metadata(path) for path in files.values())
-        storage.write_json_atomically(dict(
+        storage.write_record_atomically(dict(
             layout=storage.LAYOUT, fingerprint=fingerprint, config=current,
             command_line=command_line,
             field_notes=FIELD_NOTES, reruns=[],

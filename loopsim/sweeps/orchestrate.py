@@ -1,5 +1,6 @@
 """The top level of a sweep: :func:`run_sweep` (check, prepare the directory, plan the
 pieces, hand them to a backend, read the table back) and its Python form :func:`sweep`."""
+import json
 import os
 
 import numpy as np
@@ -15,6 +16,7 @@ from ..outcomes import Thresholds
 from .cases import SweepConfig, grid_cases, validate
 from .chunks import canonical_chunks, covered_ids, pending_pieces
 from .dask_backend import close_cluster, dask_client, run_dask
+from . import lock
 from .directory import prepare_directory
 from .local import run_local
 from .progress import Progress, case_weight
@@ -34,6 +36,8 @@ def run_sweep(config, out, threads=None, quiet=False, command_line=None, *, sche
     (i, n): only the chunks k with k % n == i (job arrays).  ``unit``: positions per
     task of the local work queue (default 1: a signal loses at most the cases in
     flight).
+    The directory is held (``lock``) before any case runs: a second command into it is
+    refused while this one runs, unless it is another shard of the same sweep.
     SIGINT/SIGTERM: finished cases are written, then :class:`SweepInterrupted` is
     raised (the running tasks' cases are lost; called from Python, their worker threads
     run on until their kernel returns, then stop).
@@ -65,7 +69,9 @@ def run_sweep(config, out, threads=None, quiet=False, command_line=None, *, sche
     if distributed:  # connected first: a scheduler refused leaves no directory behind
         workers = workers or max(1, numba.config.NUMBA_NUM_THREADS // (threads or 1))
         client, cluster = dask_client(scheduler, workers)
+    held = None
     try:
+        held = _hold(out, config, shard, command_line)
         fingerprint = prepare_directory(out, config, command_line or [])
         covered = storage.chunk_files(out)
         pieces = pending_pieces(config, covered, shard)
@@ -86,6 +92,8 @@ def run_sweep(config, out, threads=None, quiet=False, command_line=None, *, sche
                 run_local(config, out, fingerprint, pieces, threads, unit or 1, progress,
                           stop, weights)
     finally:
+        if held is not None:
+            held.release()
         if client is not None:
             grace = 1 if stop.is_set() else None  # on a signal: no waiting for tasks
             if grace is not None:  # connections cut short are expected now, not errors
@@ -112,6 +120,16 @@ def warn_mixed_columns(frame, out):
     if text is not None:
         warnings.warn(f"{out}: {text}", LoopsimWarning, stacklevel=3)
     return frame
+
+
+def _hold(out, config, shard, command_line):
+    """Hold ``out`` for this sweep (``lock.hold``) once the checks that need no directory
+    have passed (a layout-1 directory, a round of a ``--seeds auto`` sweep planned
+    otherwise): a refused command makes no directory."""
+    fingerprint = storage.config_fingerprint(json.loads(json.dumps(config.as_dict())))
+    storage.check_layout(out)
+    storage.check_round_directory(out, fingerprint)
+    return lock.hold(out, lock.holder(fingerprint, shard), command_line)
 
 
 def sweep(g0, theta0_deg, out, *, n="auto", seeds=1, method=None, t_end=DEFAULT_T_END,

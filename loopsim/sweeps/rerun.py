@@ -7,6 +7,7 @@ import pyarrow as pa
 
 from .. import refinement, storage, validation
 from ..outcomes import Thresholds
+from . import lock
 from .cases import SweepConfig
 from .orchestrate import run_sweep
 from .seeds_auto import restate_stop_table
@@ -29,18 +30,28 @@ def rerun_failed(out, method, rtol, atol, **backend):
     every result file holding those cases is rewritten with the new rows (its metadata
     lists the attempt) after the original was copied to ``out/_reruns/k/replaced/``.
     Returns (the results DataFrame, the number of cases rerun).  ``backend``: as for
-    :func:`run_sweep` (threads, quiet, scheduler, local_cluster, workers, ...).
+    :func:`run_sweep` (threads, quiet, scheduler, local_cluster, workers, ...).  The
+    directory is held (``lock``) throughout: refused while any sweep runs in it.
     """
     if method is not None:
         validation.check_choice("--method", method, refinement.METHOD_CHOICES)
     validation.check_real("--rtol", rtol, low=0.0, low_open=True)  # before anything is
     validation.check_real("--atol", atol, low=0.0)  # recorded: a refused rerun leaves no trace
     if os.path.isdir(out) and storage.is_seeds_auto(out):
-        return _rerun_rounds(out, method, rtol, atol, **backend)
+        with lock.acquire(out, lock.holder(None, exclusive=True)):
+            return _rerun_rounds(out, method, rtol, atol, **backend)
     stored = storage.read_sweep_file(out) if os.path.isdir(out) else None
     if stored is None:
         raise ValueError(f"no sweep at {out!r} (no {storage.SWEEP_FILE}) to rerun failed cases of")
     storage.check_layout(out)
+    with lock.acquire(out, lock.holder(stored["fingerprint"], exclusive=True)):
+        stored = storage.read_sweep_file(out)  # as it is now that no one else writes it
+        return _rerun_sweep(out, stored, method, rtol, atol, **backend)
+
+
+def _rerun_sweep(out, stored, method, rtol, atol, **backend):
+    """:func:`rerun_failed` on the sweep directory ``out`` (its decoded ``_sweep.json``:
+    ``stored``), held by this command."""
     base = config_from_dict(stored["config"])
     settings = dict(method=method or base.method, rtol=rtol, atol=atol)
     reruns = stored.get("reruns", [])
@@ -62,7 +73,7 @@ def rerun_failed(out, method, rtol, atol, **backend):
         open_attempt = dict(attempt=len(reruns) + 1, settings=settings, case_ids=failed,
                             merged=False)
         stored["reruns"] = reruns + [open_attempt]
-        storage.write_json_atomically(stored, os.path.join(out, storage.SWEEP_FILE))
+        storage.write_record_atomically(stored, os.path.join(out, storage.SWEEP_FILE))
     ids = open_attempt["case_ids"]
     directory = os.path.join(out, storage.RERUN_DIR, str(open_attempt["attempt"]))
     config = dataclasses.replace(base, cases=[base.cases[i] for i in ids], snapshots_for=[],
@@ -71,7 +82,7 @@ def rerun_failed(out, method, rtol, atol, **backend):
     _merge_rerun(out, stored["fingerprint"], directory, open_attempt["attempt"],
                  rerun.assign(case_id=[ids[i] for i in rerun["case_id"]]))
     open_attempt["merged"] = True
-    storage.write_json_atomically(stored, os.path.join(out, storage.SWEEP_FILE))
+    storage.write_record_atomically(stored, os.path.join(out, storage.SWEEP_FILE))
     return storage.read_results(out), len(ids)
 
 
@@ -103,7 +114,7 @@ def _merge_rerun(out, fingerprint, directory, attempt, rows):
     cases; a file already carrying ``attempt`` in its metadata is done (so a merge cut
     short by a kill resumes)."""
     replaced = os.path.join(directory, "replaced")
-    os.makedirs(replaced, exist_ok=True)
+    storage.make_directories(replaced)
     new = pa.Table.from_pandas(rows, schema=storage.RESULT_SCHEMA, preserve_index=False)
     by_id = set(rows["case_id"])
     for (start, stop), path in sorted(storage.chunk_files(out).items()):

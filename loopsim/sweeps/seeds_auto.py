@@ -15,6 +15,7 @@ the runs ``run_sweep``.
 import dataclasses
 import json
 import os
+import warnings
 
 import pandas as pd
 import pyarrow as pa
@@ -22,6 +23,7 @@ import pyarrow as pa
 from .. import (
     columns, outcome_statistics, outcomes, seeds_auto_rule, storage, validation,
 )
+from . import lock
 from .cases import validate
 
 #: The inputs that tell the cells apart (the seed never does).  Every other input of a
@@ -55,9 +57,10 @@ def _differences(stored, record):
 
 
 def prepare(out, config, targets, command_line):
-    """Make ``out`` for this ``--seeds auto`` sweep, or check that it holds this very one
-    (the same cells, targets and options, the chunk size aside); a one-line ValueError
-    otherwise.  Returns what it made (paths, deepest last) for :func:`_undo`."""
+    """Write the record of this ``--seeds auto`` sweep into the directory ``out``, or check
+    that it holds this very one (the same cells, targets and options, the chunk size
+    aside); a one-line ValueError otherwise.  Returns what it made (the record, or
+    nothing) for :func:`_undo`."""
     record = _record(config, targets)
     stored = storage.read_seeds_file(out)
     if stored is not None:
@@ -68,26 +71,54 @@ def prepare(out, config, targets, command_line):
         return []
     if os.path.isfile(os.path.join(out, storage.SWEEP_FILE)):
         raise ValueError(f"{out!r} holds a sweep with fixed --seeds; use another --out")
+    if os.path.isdir(storage.round_directory(out, 0)):
+        warnings.warn(f"{os.path.join(out, storage.SEEDS_FILE)!r} is missing although "
+                      f"{out!r} holds rounds: rebuilt from this command's options, each "
+                      "round checked against them as it resumes", stacklevel=2)
+    storage.write_seeds_file(out, dict(record, rounds=[], command_line=command_line or [],
+                                       **json.loads(json.dumps(storage.provenance()))))
+    return [os.path.join(out, storage.SEEDS_FILE)]
+
+
+def _make_directory(out):
+    """Make ``out`` if absent; the directories made, outermost first (for :func:`_undo`)."""
     made = []
     missing = os.path.abspath(out)
     while not os.path.exists(missing):
         made.insert(0, missing)
         missing = os.path.dirname(missing)
-    os.makedirs(out, exist_ok=True)
-    storage.write_json_atomically(dict(record, rounds=[], command_line=command_line or [],
-                                  **json.loads(json.dumps(storage.provenance()))),
-                             os.path.join(out, storage.SEEDS_FILE))
-    return made + [os.path.join(out, storage.SEEDS_FILE)]
+    storage.make_directories(out)
+    return made
+
+
+def _fingerprint(config, targets):
+    """What a ``--seeds auto`` sweep computes, as a fingerprint (``storage.config_fingerprint``
+    of its options and targets; the chunk size aside): the directory's holder records it."""
+    return storage.config_fingerprint(dict(json.loads(json.dumps(config.as_dict())),
+                                           seeds_auto_targets=dataclasses.asdict(targets)))
 
 
 def _undo(made):
-    """Remove what :func:`prepare` made (its record, then the directories it made, if
-    empty): a command refused before its first round leaves the file system as it was."""
+    """Remove what :func:`prepare` made (its record) or :func:`_make_directory` (the
+    directories, if empty): a command refused before its first round leaves the file
+    system as it was."""
     for path in reversed(made):
         try:
             os.remove(path) if os.path.isfile(path) else os.rmdir(path)
         except OSError:
             return
+
+
+def _round_record_missing(out):
+    """Whether a round directory of ``out`` has lost its ``_sweep.json`` (moved away as its
+    damage advised): the rounds are then planned again, and each resumes and rewrites it."""
+    index = 0
+    while os.path.isdir(storage.round_directory(out, index)):
+        if not os.path.isfile(os.path.join(storage.round_directory(out, index),
+                                           storage.SWEEP_FILE)):
+            return True
+        index += 1
+    return False
 
 
 def _record_round(out, index, fingerprint):
@@ -103,7 +134,7 @@ def _record_round(out, index, fingerprint):
                              "changed); use another --out")
         return
     stored["rounds"] = rounds + [fingerprint]
-    storage.write_json_atomically(stored, os.path.join(out, storage.SEEDS_FILE))
+    storage.write_seeds_file(out, stored)
 
 
 def check_size(cells, targets):
@@ -265,17 +296,34 @@ def run_seeds_auto(config, out, targets, *, run_round, command_line=None, announ
     runs at all) and the stop table records the verdicts.
     Every input is checked before anything is written; a command that fails before its
     first round leaves nothing behind.  A finished directory (its stop table written) is
-    read back, not planned again (a ``--rerun-failed`` may have replaced failed rows).
+    read back, not planned again (a ``--rerun-failed`` may have replaced failed rows),
+    unless a round has lost its ``_sweep.json``: planned again, the rounds resume and the
+    lost file is rewritten (a round whose rows a rerun changed may then be refused).
     """
     targets.check()
     cells = [dict(case, seed=0) for case in config.cases]
     validate(dataclasses.replace(config, cases=cells))  # distinct cells among the rest
     check_size(cells, targets)
+    directories = _make_directory(out)
+    try:
+        with lock.acquire(out, lock.holder(_fingerprint(config, targets)), command_line):
+            return _run_rounds(config, out, targets, cells, run_round, command_line, announce)
+    except BaseException:
+        _undo(directories)  # those this call made, if empty (the record is gone with them)
+        raise
+
+
+def _run_rounds(config, out, targets, cells, run_round, command_line, announce):
+    """:func:`run_seeds_auto` in the directory ``out``, held by this command."""
     made = prepare(out, config, targets, command_line)
-    if not made and os.path.isfile(os.path.join(out, storage.STOPS_FILE)):
+    if (not made and os.path.isfile(os.path.join(out, storage.STOPS_FILE))
+            and not _round_record_missing(out)):
         return storage.read_seeds_auto(out), storage.read_stop_table(out)
     rows = None
     index = 0
+    existing = 0  # rounds already there (a record rebuilt: :func:`prepare`)
+    while made and os.path.isdir(storage.round_directory(out, existing)):
+        existing += 1
     try:
         while True:
             cases = plan_round(cells, rows, targets, twins=config.twin)
@@ -294,8 +342,11 @@ def run_seeds_auto(config, out, targets, *, run_round, command_line=None, announ
                               expected_costs(cases, rows, config.twin)).assign(round=index)
             rows = frame if rows is None else pd.concat([rows, frame], ignore_index=True)
             index += 1
-    except BaseException:
-        if made and not os.path.isdir(storage.round_directory(out, 0)):
+    except BaseException as exc:
+        # a record made by this call goes again when it added no rows: a fresh
+        # directory's, or one rebuilt that a round already there refused (other options)
+        refused = isinstance(exc, ValueError) and index < existing
+        if made and (refused or not os.path.isdir(storage.round_directory(out, 0))):
             _undo(made)
         raise
     checks = None
