@@ -5,7 +5,7 @@ cases, Dask workers), and each case's kernels call BLAS through ``np.dot`` on
 small matrices (scipy's OpenBLAS; M × M with M = 4n + 1).  OpenBLAS splits large
 enough products over its own thread pool, one per core, so a sweep on all cores
 runs threads² threads: a 4-case n = 24 sweep on 2 threads took 80.6 s against
-17.2 s with one BLAS thread (docs/performance.md, "BLAS threads").  Every integration
+17.2 s with one BLAS thread (docs/studies/performance.md, "BLAS threads").  Every integration
 therefore runs under threadpoolctl's limit of one BLAS thread.
 
 The limit is process-wide, and threadpoolctl lets one Python thread at a time

@@ -31,7 +31,7 @@ DEFAULT_PERTURBATION = 1e-3
 
 #: The ensemble every probability over seeds is taken over (``shapes.tilted_circle``'s
 #: recipe), in one line (named in
-#: ``--help``, in summary tables' metadata and in docs/convergence-top.md).
+#: ``--help``, in summary tables' metadata and in docs/studies/convergence-top.md).
 PERTURBATION_ENSEMBLE = (
     "seed k perturbs modes 2 to the starting order n (6 with --n auto, zero-padded as n "
     "climbs) with amplitudes N(0,1)/m^2 from numpy.random.default_rng(k), scaled to RMS "
@@ -60,7 +60,7 @@ DEFAULT_STEADY_TOL = 1e-6
 #: (scripts/auto_study.py, docs/auto-and-determinacy.md): against fixed n = 32 runs from
 #: the same start, the determined auto rows of 25 cases end within 0.0068 deg in tilt and
 #: 1.9e-4 in aspect ratio.  The earlier tail, relative to the loop's size, let 3D tilts
-#: end up to 18 deg off (docs/earlier-n-auto.md).
+#: end up to 18 deg off (docs/studies/earlier-n-auto.md).
 RESOLVED_LENGTH_ERROR = 1e-5
 RESOLVED_TAIL = 1e-5
 #: The spectral tail is measured against the loop's deformation (modes k >= 2), floored at

@@ -6,7 +6,7 @@ kernel's helpers): a plain ``numba.njit`` dispatcher with its Python entry wrapp
 ``@kernel``: a function compiled code calls.  It is compiled *without* the Python
 (``cpython``) and C (``cfunc``) entry wrappers Numba would build by default: for a
 kernel taking a problem namedtuple (some 40 arrays) the wrappers are about a fifth of
-its LLVM IR (``loop_velocity``: 2 180 of 9 317 lines); docs/performance.md,
+its LLVM IR (``loop_velocity``: 2 180 of 9 317 lines); docs/studies/performance.md,
 "Compilation", measures what leaving them out saves.
 Jitted callers see the plain dispatcher (``_numba_type_``); a call from Python (tests,
 interactive use) goes through a small uncached trampoline compiled on first use, so
@@ -98,7 +98,7 @@ def kernel(function=None, *, inline=False):
     (Numba's ``inline="always"``, before typing) instead of calling it, so it has no
     library of its own.  For a large kernel with one or two callers: every library that
     calls another links in and compiles again all the code below it, so a kernel between
-    two big ones costs a compilation of everything under it (docs/performance.md,
+    two big ones costs a compilation of everything under it (docs/studies/performance.md,
     "Compilation").  The arithmetic is the same operations either way (no fastmath), so
     results do not change."""
     if function is None:

@@ -22,7 +22,7 @@ Products.  :func:`add_product` and :func:`gram_upper` call BLAS's gemm through
 ``numba_xxgemm`` (``np.dot`` calls it too) by blocks of rows: at the tension solve's
 sizes (K = 2n + 1 ≤ 65 rows, M = 4n + 1 columns) scipy's OpenBLAS then takes its
 small-matrix kernels, and the Gram matrix costs only its upper triangle
-(docs/performance.md, "Fewer products for the tension").
+(docs/studies/performance.md, "Fewer products for the tension").
 """
 import numba
 import numpy as np
@@ -151,7 +151,7 @@ def solve(a, b):
 
     Without Numba's version, whose copy of b is a slice assignment: its broadcasting
     check's error message compiles string formatting code, and every library holding the
-    exact Jacobian held it (docs/performance.md, "Compilation").
+    exact Jacobian held it (docs/studies/performance.md, "Compilation").
     """
     n = a.shape[0]
     nrhs = b.shape[1]

@@ -20,7 +20,7 @@ def start(method, problem, y, f, options):
 #: left to be done at their (y, f).  The driver calls ``attempt(..., CATCH_UP, ...)``
 #: right after each of them, so the work is done where it was asked for; radau5 leaves
 #: its Jacobian evaluations to it, so that besides the driver one compiled function (the
-#: attempt) holds the Jacobian's code, not three (docs/performance.md, "Compilation").
+#: attempt) holds the Jacobian's code, not three (docs/studies/performance.md, "Compilation").
 #: A real step has h > 0 (``control.stop_check`` ends the run first).
 CATCH_UP = -1.0
 

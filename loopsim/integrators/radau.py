@@ -107,7 +107,7 @@ NOISE_MARGIN = 10.0
 #: Jacobians 0.64-0.79x, priced cost 0.61-0.85x, wall time 0.56-0.91x; at equal end-state
 #: error over 0.1 t_u 0.56-0.74x.  On the well-posed cases of bench_step_control.py, 0.83x
 #: at equal terminal-tilt error, at most 1 % more RHS evaluations (one F per Jacobian, at
-#: its point).  Points from 0.5 to 1 do about as well (docs/development-notes-levers.md).
+#: its point).  Points from 0.5 to 1 do about as well (docs/studies/development-notes-levers.md).
 JACOBIAN_POINT = 0.578
 
 #: The method as data: its error order and the policy constants above.

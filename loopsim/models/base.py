@@ -39,7 +39,7 @@ def monitored_errors(problem, y):
       0 for a model without a truncation.
 
     One generic for the three: each implementation taking the problem is a compiled
-    library of its own (docs/performance.md, "Compilation")."""
+    library of its own (docs/studies/performance.md, "Compilation")."""
     raise NotImplementedError("only callable from jitted code")
 
 

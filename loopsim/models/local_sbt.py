@@ -50,7 +50,7 @@ implements(rhs, LoopProblem)(loop_velocity)
 def _loop_jacobian(problem, y, f, jac, work_y, work_f):
     # loop_jacobian's two calls, not a call of that kernel: every library holding the
     # Jacobian holds all its callees' code, so a layer fewer compiles it once less
-    # (docs/performance.md, "Compilation").
+    # (docs/studies/performance.md, "Compilation").
     k = y.shape[0] // 3
     x = y.reshape((3, k))
     u = np.empty_like(x)

@@ -31,7 +31,7 @@ the elementwise product.  A = (B₂ + B B) S0 costs one (K, M) @ (M, M) product,
 B (B S0): B S0 and B₂ S0 take O(n M) operations (:func:`tension_columns`: the
 product of the tangent with one basis function loses, on projection, only the modes
 above n, which come from the tangent's top modes), where forming them took two
-more such products (docs/performance.md, "Fewer products for the tension").  The
+more such products (docs/studies/performance.md, "Fewer products for the tension").  The
 column-block form (:func:`compose_maps`, :func:`loop_velocity_blocks`) stays
 for the Jacobian and as the reference the fast path is tested against.
 """
@@ -325,7 +325,7 @@ def loop_velocity(problem, y, dydt):
 
     Not decorated: it is compiled as the local model's ``rhs`` implementation
     (``local_sbt``), holding its code itself rather than calling a kernel that does, so
-    a run compiles the velocity's code in one library fewer (docs/performance.md,
+    a run compiles the velocity's code in one library fewer (docs/studies/performance.md,
     "Compilation").  From Python: ``models.evaluate``.
     """
     g0 = problem.g0

@@ -13,7 +13,7 @@ from .. import _jitcache, diagnostics
 #: ``--n auto`` sweeps: a 3D case's wall time grows like q0**AUTO_COST_EXPONENT.  Fitted
 #: (log-log least squares) to the 24 3D cases among the first 32 of the resolved main-job
 #: grid (radau5, rtol 1e-6, t = 10): exponent 3.95, and 0.058 s × (q0 / 11)^3.95 meets the
-#: cheap cases' median, 0.066 s, at q0 = 11 (docs/earlier-n-auto.md).
+#: cheap cases' median, 0.066 s, at q0 = 11 (docs/studies/earlier-n-auto.md).
 AUTO_COST_EXPONENT = 4.0
 #: The ETA is shown ("?" before) once the finished cases carry this share of the run's
 #: estimated cost: extrapolated from one cheap case it was 10x off (32 min for the
@@ -37,7 +37,7 @@ ETA_UPPER_EVERY = 5.0
 
 def case_weight(case, n_auto=False):
     """Estimated relative cost of a case, for the ETA.  Fixed n: n², times 3 when q0 > 11
-    (3D loops: 2.7× the RHS evaluations of stable ones in docs/performance.md; one
+    (3D loops: 2.7× the RHS evaluations of stable ones in docs/studies/performance.md; one
     RHS costs about n^1.7).  ``n_auto``: n² × (q0 / 11)^4 when q0 > 11 (the resolved 3D
     transient climbs to n = 24–32, and its cost spans 1 s to minutes with q0)."""
     theta = case.get("theta0_deg", math.nan)
