@@ -21,7 +21,11 @@ The tables:
 * ``data/paper_range_runs/paper_range_top24``: the runs of g0 = 252.9-350 at 24-30 deg.
 * ``data/convergence_top.parquet`` and ``data/convergence_runs``: the convergence study at
   the top of the range.
+* ``data/rest_study.parquet``: the run-to-rest study (``scripts/rest_study.py``).
+* ``data/rest_window.json``: where loops can rest, ``loopsim rest-window --g0 10:350:15
+  --json`` (tests/test_rest_window.py checks it against the code).
 """
+import json
 import argparse
 import functools
 import glob
@@ -238,8 +242,87 @@ def _convergence():
     }
 
 
+def _rest_window():
+    """The losses of stability along the steady branch and the tilt windows of the
+    paper's g0 grid (``data/rest_window.json``)."""
+    with open(os.path.join(DATA, "rest_window.json"), encoding="utf-8") as handle:
+        window = json.load(handle)
+    out_of_plane, in_plane, fold = window["losses"]
+    rows = ["| g0 | q0 = g0 / 3 at 90° | window θ_low–θ_high (deg) |", "|--:|--:|--|"]
+    for row in window["windows"]:
+        low = "none (every rest a circle)" if row["theta_low_deg"] is None else \
+            f"{row['theta_low_deg']:.2f}–{row['theta_high_deg']:.2f}"
+        rows.append(f"| {row['g0']:.1f} | {row['g0'] / 3:.1f} | {low} |")
+    return {
+        "rest.n": str(window["n"]),
+        "rest.q-circle": f"{window['q_circle']:.4f}",
+        "rest.hopf-out-q": f"{out_of_plane['q']:.5f}",
+        "rest.hopf-out-frequency": f"{out_of_plane['frequency']:.3f}",
+        "rest.hopf-in-q": f"{in_plane['q']:.5f}",
+        "rest.hopf-in-frequency": f"{in_plane['frequency']:.3f}",
+        "rest.fold-q": f"{fold['q']:.2f}",
+        "rest.window-table": "\n\n" + "\n".join(rows) + "\n\n",
+    }
+
+
+def _interval(value, low, high, digits, unit=""):
+    if not np.isfinite(value):
+        return "not reached"
+    ends = ", ".join("beyond the runs" if not np.isfinite(v) else f"{v:.{digits}f}"
+                     for v in (low, high))
+    return f"{value:.{digits}f}{unit} [{ends}]"
+
+
+def _rest_study():
+    """Per cell of the run-to-rest study: ``rest.<g0>-<theta0>.<statistic>``, and the
+    table of every cell (``rest.study-table``)."""
+    path = os.path.join(DATA, "rest_study.parquet")
+    if not os.path.exists(path):
+        return {}
+    frame = pd.read_parquet(path)
+    out, rows = {}, [
+        "| g0, θ0 | q0 | at rest by t = 40 | P(at rest by t = 10) | median settling time "
+        "| 95 % at rest by | escape rate after t = 10 (per t_u) | window (deg) "
+        "| at rest: inside / below / outside | P(3D) at rest | tilt quartiles at rest (deg) |",
+        "|---|--:|--:|---|---|--:|---|---|--:|--:|---|"]
+    for _, r in frame.iterrows():
+        key = f"rest.{r['g0']:.0f}-{r['theta0_deg']:.0f}"
+        cell = {
+            "at-rest": f"{r['at_rest']} of {r['rest_observed']}",
+            "moving": count(r["moving_at_t_max"]),
+            "p10": _interval(r["p_rest_t10"], r["p_rest_t10_low"], r["p_rest_t10_high"], 2),
+            "median": _interval(r["t_rest_median"], r["t_rest_median_low"],
+                                r["t_rest_median_high"], 1),
+            "q95": "not reached" if not np.isfinite(r["t_rest_q95"]) else f"{r['t_rest_q95']:.1f}",
+            "escape": (f"{r['escape_events']} events: too few"
+                       if not np.isfinite(r["escape_rate"]) else
+                       _interval(r["escape_rate"], r["escape_rate_low"], r["escape_rate_high"], 2)),
+            "window": f"{r['window_low_deg']:.2f}–{r['window_high_deg']:.2f}",
+            "where": f"{r['rest_inside']} / {r['rest_below']} / {r['rest_outside']}",
+            "p3d": f"{r['p_3d']:.2f}",
+            "tilts": " / ".join(f"{r[c]:.1f}" for c in ("tilt_q25", "tilt_median", "tilt_q75")),
+        }
+        out.update({f"{key}.{k}": v for k, v in cell.items()})
+        rows.append(f"| ({r['g0']:.1f}, {r['theta0_deg']:.0f}°) | {r['q0']:.1f} | "
+                    + " | ".join(cell[k] for k in ("at-rest", "p10", "median", "q95", "escape",
+                                                    "window", "where", "p3d", "tilts")) + " |")
+        if isinstance(r.get("baseline"), str):
+            out[f"{key}.verdict"] = r["verdict"]
+            out[f"{key}.delta-p3d"] = _interval(r["delta_p_3d"], r["delta_p_3d_low"],
+                                                r["delta_p_3d_high"], 2)
+            out[f"{key}.delta-tilt50"] = _interval(r["delta_tilt_q50"], r["delta_tilt_q50_low"],
+                                                   r["delta_tilt_q50_high"], 1, "°")
+            out[f"{key}.detectable-p3d"] = f"{r['delta_p_3d_detectable']:.2f}"
+            out[f"{key}.detectable-tilt50"] = f"{r['delta_tilt_q50_detectable']:.1f}°"
+            out[f"{key}.base-p10"] = f"{r['base_p_steady']:.2f}"
+    out["rest.study-table"] = "\n\n" + "\n".join(rows) + "\n\n"
+    out["rest.cells"] = count(len(frame))
+    return out
+
+
 #: Groups of keys, each computed together from one table; a key's function is its group's.
-GROUPS = (_n6_counts, _n6_labels, _grid_costs, _top_costs, _tumbling_samples, _convergence)
+GROUPS = (_n6_counts, _n6_labels, _grid_costs, _top_costs, _tumbling_samples, _convergence,
+          _rest_window, _rest_study)
 
 
 @functools.lru_cache(maxsize=None)

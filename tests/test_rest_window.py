@@ -72,3 +72,25 @@ def test_cli_prints_the_window_as_json():
     high = data["windows"][0]["theta_high_deg"]
     assert 350 * math.sin(math.radians(high)) / 3 == pytest.approx(first["q"])
     assert data["windows"][1]["theta_low_deg"] is None      # g0 = 20 < 3 q_c: NaN -> null
+
+
+def test_the_committed_window_table_is_the_codes(window):
+    """data/rest_window.json (whose numbers docs/stability.md renders) is what the code
+    computes now: ``loopsim rest-window --g0 10:350:15 --json``."""
+    import os
+
+    import numpy as np
+
+    path = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                        "data", "rest_window.json")
+    with open(path, encoding="utf-8") as handle:
+        committed = json.load(handle)
+    now = window.as_dict(np.linspace(10.0, 350.0, 15))
+    assert committed["n"] == now["n"] and len(committed["losses"]) == len(now["losses"])
+    for a, b in zip(committed["losses"], now["losses"]):
+        assert (a["kind"], a["sector"]) == (b["kind"], b["sector"])
+        assert a["q"] == pytest.approx(b["q"], abs=1e-8)
+    for a, b in zip(committed["windows"], now["windows"]):
+        assert a["g0"] == pytest.approx(b["g0"])
+        for key in ("theta_low_deg", "theta_high_deg"):
+            assert (a[key] is None and b[key] is None) or a[key] == pytest.approx(b[key], abs=1e-7)
