@@ -173,7 +173,8 @@ def test_summary_figure_help_says_what_the_figure_draws():
     from loopsim.figures import distributions
 
     source = inspect.getsource(distributions.distribution_summary)
-    assert "probability_phase_diagram(cells, ax=axes[0])" in source  # the default style
+    call = source[source.index("probability_phase_diagram(cells, ax=axes[0]"):].split(")")[0]
+    assert "style" not in call  # the default style
     style = inspect.signature(distributions.probability_phase_diagram).parameters["style"]
     action = next(a for a in subcommands(cli.build_parser())["summary"]._actions
                   if "--figure" in a.option_strings)
