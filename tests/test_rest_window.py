@@ -6,6 +6,7 @@ Hopf point at q = 37.553191 (Im sigma = 22.088), in plane a Hopf point at q = 45
 4.4-18.8 deg at g0 = 350."""
 import json
 import math
+import os
 import subprocess
 import sys
 
@@ -16,7 +17,7 @@ from loopsim.stability import rest_window as rw
 
 @pytest.fixture(scope="module")
 def window():
-    return rw.stability_losses(rw.DEFAULT_WINDOW_N)
+    return rw.stability_losses(rw.DEFAULT_WINDOW_N, cache=False)  # computed here, not read
 
 
 def test_losses_along_the_branch(window):
@@ -94,3 +95,18 @@ def test_the_committed_window_table_is_the_codes(window):
         assert a["g0"] == pytest.approx(b["g0"])
         for key in ("theta_low_deg", "theta_high_deg"):
             assert (a[key] is None and b[key] is None) or a[key] == pytest.approx(b[key], abs=1e-7)
+
+
+def test_a_computed_window_is_kept_and_read_back(tmp_path, monkeypatch):
+    """The window is kept beside the kernels and read back equal; a damaged file is
+    computed anew (n = 8: seconds)."""
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    compute = rw.stability_losses.__wrapped__            # past the in-process lru_cache
+    first = compute(8)
+    path = rw._cache_path(8, 10.0, 80.0, 1e-10)
+    assert os.path.isfile(path) and str(tmp_path) in path
+    assert compute(8).as_dict() == first.as_dict()        # read back: the same losses
+    with open(path, "w", encoding="utf-8") as handle:
+        handle.write("{not json")
+    assert compute(8).losses[0].q == first.losses[0].q    # recomputed
+    assert json.load(open(path, encoding="utf-8"))["q_loss"] == first.q_loss

@@ -25,11 +25,13 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import json
 import math
+import os
 
 import numpy as np
 
-from .. import validation
+from .. import _jitcache, storage, validation
 from ..defaults import DEFAULT_W
 from . import branch
 
@@ -154,14 +156,58 @@ def _fold(shapes):
                          frequency=math.nan)
 
 
+#: The modules a window depends on beyond the kernels (whose source the cache directory
+#: is already named after): a change in any of them computes the window anew.
+WINDOW_SOURCES = ("stability/rest_window.py", "stability/branch.py", "stability/steady.py",
+                  "stability/full_linear.py")
+
+
+def _cache_path(n, w, q_max, tol):
+    """Where a computed window is kept: the kernels' cache directory
+    (``loopsim._jitcache.cache_dir``), under a name holding a hash of
+    :data:`WINDOW_SOURCES` and the arguments."""
+    sources = [os.path.join(_jitcache.PACKAGE_DIR, *name.split("/")) for name in WINDOW_SOURCES]
+    return os.path.join(_jitcache.cache_dir(),
+                        f"rest-window-{_jitcache.source_hash(sources)}-n{n}-w{w!r}-q{q_max!r}"
+                        f"-tol{tol!r}.json")
+
+
+def _from_record(record):
+    return RestWindow(n=int(record["n"]), w=float(record["w"]),
+                      q_circle=float(record["q_circle"]),
+                      losses=tuple(StabilityLoss(q=float(loss["q"]), kind=loss["kind"],
+                                                 sector=loss["sector"],
+                                                 frequency=math.nan if loss["frequency"] is None
+                                                 else float(loss["frequency"]))
+                                   for loss in record["losses"]))
+
+
 @functools.lru_cache(maxsize=8)
-def stability_losses(n=DEFAULT_WINDOW_N, w=DEFAULT_W, q_max=80.0, tol=1e-10):
+def stability_losses(n=DEFAULT_WINDOW_N, w=DEFAULT_W, q_max=80.0, tol=1e-10, cache=True):
     """The losses of stability along the branch's in-plane-stable half, in order of q:
     the first out-of-plane and in-plane crossings (Hopf or steady) and the fold, as a
-    :class:`RestWindow` (computed once per process and arguments; about a minute of one
-    core at n = 16)."""
+    :class:`RestWindow`.  About 20 s of one core at n = 16; once computed it is kept
+    beside the compiled kernels (``cache``; a change to the code it depends on computes it
+    anew) and read back in milliseconds."""
     n = validation.check_count("n", n, 4, validation.MAX_BRANCH_N,
                                "the continuation's cost grows like n^3 per point")
+    path = _cache_path(n, float(w), float(q_max), float(tol)) if cache else None
+    if path is not None and os.path.isfile(path):
+        try:
+            with open(path, encoding="utf-8") as handle:
+                return _from_record(json.load(handle))
+        except (OSError, ValueError, KeyError, TypeError):
+            pass  # unreadable: computed anew and written over
+    window = _compute_losses(n, float(w), float(q_max), float(tol))
+    if path is not None:
+        try:
+            storage.write_json_atomically(window.as_dict(), path)
+        except OSError:
+            pass  # a read-only cache: the window is still returned
+    return window
+
+
+def _compute_losses(n, w, q_max, tol):
     half = branch.upper_half(n, q_max, w, step_max=WINDOW_STEP_MAX, stop_after_fold=True)
     shapes = half.shapes
     qs = [s.q for s in shapes]
@@ -177,7 +223,7 @@ def stability_losses(n=DEFAULT_WINDOW_N, w=DEFAULT_W, q_max=80.0, tol=1e-10):
         losses.append(fold)
     if not losses:
         raise ValueError(f"no loss of stability along the branch up to q = {q_max} at n = {n}")
-    return RestWindow(n=n, w=float(w), q_circle=float(half.q_circle),
+    return RestWindow(n=n, w=w, q_circle=float(half.q_circle),
                       losses=tuple(sorted(losses, key=lambda loss: loss.q)))
 
 
