@@ -124,7 +124,7 @@ def _figures(frame, cells, seeds_auto):
              else "phase diagram")
     try:
         fig = (figures.distribution_summary(cells, frame) if seeds_auto
-               else figures.phase_diagram(frame))
+               else figures.phase_diagram(frame, rest_window=figures.rest_window_for(frame)))
     except ValueError as exc:
         return (f"<h2>{html.escape(title.capitalize())}</h2><p class='warn'>not drawn: "
                 f"{html.escape(str(exc))}</p>")

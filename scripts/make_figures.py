@@ -361,7 +361,9 @@ def draw(name, how, paths, out, work, quick):
         frames = [read_results(paths[step]) for step in how[1:]]
         figures.save(figures.model_outcomes(frames), target, dpi=DPI)
     elif kind == "phase":
-        figures.save(figures.phase_diagram(read_results(paths[how[1]])), target, dpi=PHASE_DPI)
+        frame = read_results(paths[how[1]])
+        figures.save(figures.phase_diagram(frame, rest_window=figures.rest_window_for(frame)),
+                     target, dpi=PHASE_DPI)
     elif kind == "summary":
         loopsim(["summary", paths[how[1]], "--figure", target], dry_run=False)
     else:

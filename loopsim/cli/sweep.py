@@ -300,7 +300,8 @@ def command(args):
             figures.save_distribution_figure(outcome_statistics.summarize(frame), frame,
                                              args.figure)
         else:
-            figures.save(figures.phase_diagram(frame), args.figure)
+            figures.save(figures.phase_diagram(frame, rest_window=figures.rest_window_for(frame)),
+                         args.figure)
         print(f"{'distribution summary' if seeds_auto else 'phase diagram'}: {args.figure}")
     if counts["failed"]:
         print(f"{counts['failed']} of {counts['cases']} cases failed (column 'status'); exit "

@@ -61,7 +61,8 @@ from .settling import rest_tilts, survival_curves
 from .style import (
     ASPECT_LABEL, CURVE_POINTS, PAPER_BAND, REGIME_STYLE, TIME_CMAP, centred_curve, coefficients,
     default_thresholds, frame_model, mark_undetermined, merged_legend_entries, model_text,
-    new_figure, order_column, orders_text, q_lines, regime_key, regime_style, resolved_mask, save,
+    new_figure, order_column, orders_text, q_lines, regime_key, regime_style, resolved_mask,
+    rest_window_curve, rest_window_for, save,
     scatter_regimes, single_axes,
 )
 from .suite import (
@@ -78,7 +79,8 @@ __all__ = [
     "mark_undetermined", "merged_legend_entries", "model_outcomes", "model_text", "new_figure",
     "nonlocal_thresholds", "order_column", "orders_text", "phase_diagram", "phase_diagrams",
     "plane_view", "probability_phase_diagram", "q_and_tilt", "q_lines", "read_run", "read_sweep",
-    "regime_key", "regime_pies", "regime_style", "resolved_mask", "rest_tilts", "run_title", "save",
+    "regime_key", "regime_pies", "regime_style", "resolved_mask", "rest_tilts", "rest_window_curve",
+    "rest_window_for", "run_title", "save",
     "save_distribution_figure", "survival_curves",
     "scatter_regimes", "seed_distributions", "settling_index", "side_view_basis", "single_axes",
     "snapshot_indices", "stability", "stability_data", "sweep_kind", "sweep_label",

@@ -7,7 +7,7 @@ import numpy as np
 
 from ..stability import branch as steady, full_linear
 from .linear import branch_lines
-from .style import REGIME_STYLE, frame_model, save, single_axes
+from .style import REGIME_STYLE, frame_model, rest_window_curve, save, single_axes
 
 #: Where the steady branch drawn under a distribution summary ends, at most (its cost
 #: grows with it: about 25 s to q = 25 at n = 12 on one core).
@@ -116,10 +116,7 @@ def probability_phase_diagram(cells, frame=None, ax=None, style="pie", rest_wind
         ax.plot(theta, 3 * q_sector / np.sin(np.radians(theta)), "k", ls=line, lw=1.0,
                 label=f"{sector} threshold, q = {q_sector:.3f}")
     if rest_window is not None:
-        loss = rest_window.losses[0]
-        ax.plot(theta, 3 * loss.q / np.sin(np.radians(theta)), color="tab:green", lw=1.2,
-                label=f"stable branch's upper edge ({loss.kind.replace('hopf', 'Hopf')}, "
-                      f"{loss.sector}), q = {loss.q:.3f}")
+        rest_window_curve(ax, rest_window, theta)
     ax.set_xlim(0, 92)
     ax.set_ylim(0, 1.08 * cells["g0"].max())
     ax.set_xlabel(r"initial tilt $\theta_0$ (deg)")

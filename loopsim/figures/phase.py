@@ -4,18 +4,22 @@ import numpy as np
 from ..stability import full_linear, paper
 from .style import (
     PAPER_BAND, REGIME_STYLE, frame_model, mark_undetermined, merged_legend_entries, model_text,
-    new_figure, order_column, orders_text, single_axes,
+    new_figure, order_column, orders_text, rest_window_curve, single_axes,
 )
 
 
-def phase_diagram(frame, ax=None, paper_band=False):
+def phase_diagram(frame, ax=None, paper_band=False, rest_window=None):
     """g0 against θ0 coloured by regime (hollow: the case is not resolved at its n, see
     ``outcomes.Thresholds.resolved``; ringed red: not determined), with the curves g0 = 3 q_c / sin θ0 of the
     paper's linear stability (q_c = 14.561, wrong sign) and of the full linearisation of
     the circle at the sweep's largest truncation (``n_used`` for ``--n auto`` rows;
     in-plane q_c ≈ 8.90, out-of-plane ≈ 10.65), in the rows' model (nonlocal: its
     thresholds at θ0 = 90°, drawn as g0 = 3 q_c / sin θ0).
-    ``paper_band``: also the paper's empirical in-plane band q = 10.5 and 18.5 (its Fig. 5)."""
+    ``paper_band``: also the paper's empirical in-plane band q = 10.5 and 18.5 (its Fig. 5).
+    ``rest_window`` (``style.rest_window_for(frame)``): also the upper edge of the stable
+    branch's tilt window, g0 = 3 q_loss / sin θ0 (its lower edge is the in-plane curve):
+    the loops of cells above it start above their window and must turn their plane before
+    they can rest."""
     fig, ax = single_axes(ax, (6.6, 4.0))
     q_paper = paper.critical_q(20)
     order = int(frame[order_column(frame)].max())
@@ -39,6 +43,8 @@ def phase_diagram(frame, ax=None, paper_band=False):
         q_sector = full_linear.critical_q(max(order, 3), sector, model=model)
         ax.plot(theta, 3 * q_sector / np.sin(np.radians(theta)), "k", ls=style, lw=1.2,
                 label=f"full linearisation,\n{sector}, q = {q_sector:.3f}")
+    if rest_window is not None:
+        rest_window_curve(ax, rest_window, theta)
     if paper_band:
         for i, q_band in enumerate(PAPER_BAND):
             ax.plot(theta, 3 * q_band / np.sin(np.radians(theta)), color="0.55", ls="-.", lw=1.0,

@@ -174,6 +174,26 @@ def default_thresholds(n=16):
                 out_of_plane=full_linear.critical_q(max(n, 3), "out-of-plane"))
 
 
+def rest_window_for(frame):
+    """The stable branch's window (``stability.rest_window.stability_losses``, computed once
+    per machine and code version) for a local-model table, None for another model (its
+    branch is not continued): what the phase diagrams take as ``rest_window``."""
+    if frame_model(frame).name != "local":
+        return None
+    from ..stability import rest_window
+
+    return rest_window.stability_losses()
+
+
+def rest_window_curve(ax, window, theta):
+    """The window's upper edge in the (θ0, g0) plane, g0 = 3 q_loss / sin θ0 (its lower
+    edge is the in-plane threshold's curve): cells above it start above their window."""
+    loss = window.losses[0]
+    kind = {"hopf": "Hopf"}.get(loss.kind, loss.kind)
+    ax.plot(theta, 3 * loss.q / np.sin(np.radians(theta)), color="tab:green", lw=1.2,
+            label=f"stable branch's upper edge\n({kind}, {loss.sector}), q = {loss.q:.3f}")
+
+
 def q_lines(ax, thresholds, vertical=True, band=True):
     """The thresholds as lines at constant q (vertical or horizontal), with the paper's
     empirical in-plane band when ``band``."""
