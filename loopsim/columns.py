@@ -337,15 +337,20 @@ REST_STUDY_COLUMNS = {
         "rest_observed", "at_rest", "rest_inside", "rest_below", "rest_outside",
         "p_rest_t10", "p_rest_t10_low", "p_rest_t10_high", "t_rest_median",
         "t_rest_median_low", "t_rest_median_high", "t_rest_q95", "escape_events",
-        "tail_time", "escape_rate", "escape_rate_low", "escape_rate_high",
-        "p_stable", "p_in_plane", "p_3d", "tilt_q25", "tilt_median", "tilt_q75",
-        "tilt_median_low", "tilt_median_high")},
+        "tail_time", "escape_rate", "escape_rate_low", "escape_rate_high")},
+    **{name: (unit, what.replace("the cell's rows", "the cell's loops at rest")
+              .replace("the cell's terminal tilts", "the terminal tilts of the cell's loops "
+                                                     "at rest"))
+       for name, (unit, what) in SUMMARY_COLUMNS.items() if name in (
+           "p_stable", "p_in_plane", "p_3d", "tilt_q25", "tilt_median", "tilt_q75",
+           "tilt_median_low", "tilt_median_high")},
     "nfev_mean": CONVERGENCE_COLUMNS["nfev_mean"],
     "wall_s": CONVERGENCE_COLUMNS["wall_s"],
     "baseline": (TEXT, "the t = 10 sweep of the same cell compared with (16 seeds at the "
                        "defaults, data/convergence_runs), or empty"),
     "base_seeds": (COUNT, "seeds of the t = 10 sample"),
-    "base_p_steady": (PROBABILITY, "share of the t = 10 sample at rest by t = 10"),
+    "base_p_steady": (PROBABILITY, "share of the t = 10 sample at rest (passed the steady "
+                                   "test) by t = 10"),
     "base_p_3d": (PROBABILITY, "share of the t = 10 sample ending 3D"),
     "base_tilt_median": (DEG, "median terminal tilt of the t = 10 sample"),
     **{k: (unit, what.replace("this setting's minus its baseline's", "at rest minus at t = 10"))
@@ -355,6 +360,7 @@ REST_STUDY_COLUMNS = {
            **{k: v for q in (25, 50, 75)
               for k, v in _difference_columns(f"tilt_q{q}", DEG, f"terminal tilt quantile {q}%")
               .items()}}.items()},
+    # (at rest: over the loops that came to rest; at t = 10: over every row of the sample)
     "verdict": (TEXT, "different (a Bonferroni interval excludes 0) or same (within the "
                       "intervals), at rest against t = 10; empty where no t = 10 sample"),
 }

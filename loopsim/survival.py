@@ -19,10 +19,13 @@ Greenwood ("log-log") band.  Per cell (:func:`settling_statistics`):
 * ``p_rest_t10``: P(at rest by the paper's horizon t = 10) = 1 − S(10), with its
   95 % interval: the Wilson interval where every run was observed to at least t = 10
   (no censoring before it: the estimate is then a binomial proportion), the KM band
-  otherwise;
-* ``t_rest_median`` (the first t with S(t) ≤ 1/2) with the times where the band's
-  limits cross 1/2 (Brookmeyer–Crowley), and ``t_rest_q95`` (the first t with
-  S(t) ≤ 0.05): NaN where the curve does not reach that far;
+  otherwise (NaN limits where the band is undefined, S(10) = 0 or 1); NaN where no run
+  was observed to t = 10 and some were still moving at their end (not estimable);
+* ``t_rest_median`` (the first t with S(t) ≤ 1/2: lifelines' convention; R's
+  ``survfit`` takes the midpoint where S = 1/2 on a whole step) with the times where
+  the band's limits cross 1/2 (Brookmeyer–Crowley; NaN: not within the runs), and
+  ``t_rest_q95`` (the first t with S(t) ≤ 0.05): NaN where the curve does not reach
+  that far;
 * the escape rate after the horizon, from the tail t > t0 = 10 taken as exponential:
   λ = D / E, D the runs that came to rest after t0, E the total time observed after
   t0 (Σ max(0, T_i − t0)), with the exact Poisson interval
@@ -31,8 +34,10 @@ Greenwood ("log-log") band.  Per cell (:func:`settling_statistics`):
   say what the tail holds).
 
 A survival that falls to zero within the runs' horizon is a transient; one that levels
-off at S > 0 with runs censored at a long t_end is a lasting tumbling state (or a
-transient longer than that horizon): :func:`survival_curve` gives the curve and band.
+off at S > 0 with runs censored at a long t_end is a lasting motion (tumbling, or a slow
+approach where the decay rate vanishes, as at the edges of the stable window) or a
+transient longer than that horizon: :func:`survival_curve` gives the curve and band,
+``terminal_state`` and the ``late_*`` columns say which motion.
 """
 import math
 import warnings
@@ -60,9 +65,9 @@ def settling_times(frame):
     (reached ``t_end``).  Rows with another ``stop_reason`` (failures) or none are
     left out."""
     reason = frame["stop_reason"]
-    keep = reason.isin(("steady", "t_end")).to_numpy(bool)
-    times = frame["t_final"].to_numpy(float)[keep]
-    return times, reason.to_numpy(object)[keep] == "steady"
+    times = frame["t_final"].to_numpy(float)
+    keep = reason.isin(("steady", "t_end")).to_numpy(bool) & np.isfinite(times)
+    return times[keep], reason.to_numpy(object)[keep] == "steady"
 
 
 def _censored(times, at_rest):
@@ -85,11 +90,12 @@ def kaplan_meier(times, at_rest, level=LEVEL):
 
 
 def _band_at(curve, estimate, t):
-    """The band's limit ``curve`` at times t, defined where S is 0 or 1 as S itself
-    (the log-log band is undefined there, and degenerate)."""
+    """The band's limit ``curve`` at times t: the log-log band is undefined where S is 0
+    or 1; before the first settling (S = 1, nothing happened yet) it is 1, as R's
+    ``survfit`` gives it, and after the last (S = 0) NaN."""
     values = np.asarray(curve.evaluate(t), float)
-    fill = np.asarray(estimate.evaluate(t), float)
-    return np.where(np.isfinite(values), values, fill)
+    before_first = np.asarray(estimate.evaluate(t), float) == 1.0
+    return np.where(np.isfinite(values), values, np.where(before_first, 1.0, np.nan))
 
 
 def survival_curve(times, at_rest, level=LEVEL):
@@ -139,24 +145,29 @@ def settling_statistics(frame, horizon=PAPER_HORIZON, level=LEVEL):
         return out
     rested_by = int(np.sum(at_rest & (times <= horizon)))
     if np.all(at_rest & (times <= horizon) | (times >= horizon)):
-        out["p_rest_t10"] = rested_by / times.size
         interval = stats.binomtest(rested_by, times.size).proportion_ci(level, method="wilson")
+        out["p_rest_t10"] = rested_by / times.size
         out["p_rest_t10_low"], out["p_rest_t10_high"] = interval.low, interval.high
     km = kaplan_meier(times, at_rest, level)
     if km is not None:
         sf, low, high = km
         grid = np.unique(times[at_rest])
         estimate = sf.evaluate(grid)
-        if math.isnan(out["p_rest_t10"]):
-            out["p_rest_t10"] = 1.0 - float(sf.evaluate(horizon))
-            out["p_rest_t10_low"] = 1.0 - float(_band_at(high, sf, horizon))
-            out["p_rest_t10_high"] = 1.0 - float(_band_at(low, sf, horizon))
+        if math.isnan(out["p_rest_t10"]) and times.max() >= horizon:
+            # censored before the horizon, some run observed past it: Kaplan-Meier
+            s10 = float(sf.evaluate(horizon))
+            out["p_rest_t10"] = 1.0 - s10
+            if 0.0 < s10 < 1.0:
+                out["p_rest_t10_low"] = 1.0 - float(high.evaluate(horizon))
+                out["p_rest_t10_high"] = 1.0 - float(low.evaluate(horizon))
         out["t_rest_median"] = _first_at_or_below(estimate, grid, 0.5)
         out["t_rest_median_low"] = _first_at_or_below(_band_at(low, sf, grid), grid, 0.5)
         out["t_rest_median_high"] = _first_at_or_below(_band_at(high, sf, grid), grid, 0.5)
         out["t_rest_q95"] = _first_at_or_below(estimate, grid, 0.05)
-    elif math.isnan(out["p_rest_t10"]):
-        out["p_rest_t10"] = 0.0
+        if math.isnan(out["p_rest_t10"]) and estimate[-1] == 0.0:
+            out["p_rest_t10"] = 1.0   # every run came to rest, all before the horizon
+    elif math.isnan(out["p_rest_t10"]) and times.max() >= horizon:
+        out["p_rest_t10"] = 0.0       # none came to rest, some observed past the horizon
     (out["escape_rate"], out["escape_rate_low"], out["escape_rate_high"],
      out["escape_events"], out["tail_time"]) = escape_rate(times, at_rest, horizon, level)
     return out

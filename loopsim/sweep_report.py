@@ -152,9 +152,10 @@ def _settling(frame, cells):
     inputs = [c for c in cells.columns if c in ("g0", "theta0_deg", "t_end")]
     parts = ["<h2>Settling</h2><p>A loop comes to rest when it passes the steady test "
              "(stop_reason steady; its settling time is t_final); one still moving at its "
-             "t_end is censored there. P(at rest by the paper's horizon t = 10) and the "
-             "median settling time are Kaplan–Meier estimates with 95 % intervals; NaN: "
-             "not reached within the runs (docs/sweeps.md).</p>",
+             "t_end is censored there. P(at rest by the paper's horizon t = 10) with its 95 % "
+             "interval (Wilson where every run was observed to t = 10, else Kaplan–Meier), "
+             "the Kaplan–Meier median settling time with its interval; NaN: not reached "
+             "within the runs (docs/sweeps.md).</p>",
              table_html(cells, inputs + [c for c in SETTLING_SHOWN if c in cells], "settling")]
     if len(cells) <= SURVIVAL_CELLS_MAX and frame["t_end"].max() > survival.PAPER_HORIZON:
         fig = figures.survival_curves(frame)

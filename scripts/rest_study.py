@@ -20,7 +20,8 @@ window at the cell's g0 (``loopsim.stability.rest_window``, n = 16) and where th
 at rest lie in it, the regime shares and tilt quartiles at rest, and, where a t = 10
 sample of the same cell exists (the convergence study's ``jmid`` sweeps, 16 seeds at
 the defaults, code c5f1a71, whose loopsim/ computes as b1d79af's), the differences of
-P(in-plane), P(3D) and the tilt quartiles at rest minus at t = 10, with 95 % intervals,
+P(in-plane), P(3D) and the tilt quartiles at rest minus at t = 10 (all its rows: what a
+t = 10 table reports), with 95 % intervals,
 the smallest difference each could detect and a verdict
 (``loopsim.distribution_differences``).  Those are two independent samples: the
 horizon changes where the integrator samples the late window, and from there on a
@@ -80,10 +81,13 @@ def indicators(frame):
 
 
 def cell_row(name, rows, base, window):
-    """One row of the table: the cell's settling statistics, its window and, with a t = 10
-    sample ``base``, the differences at rest minus at t = 10."""
+    """One row of the table: the cell's settling statistics over all its runs, its
+    window, the regime shares and tilt quartiles over the loops that came to rest, and,
+    with a t = 10 sample ``base``, the differences at rest minus at t = 10."""
     g0, theta0 = float(rows["g0"].iloc[0]), float(rows["theta0_deg"].iloc[0])
     stats = outcome_statistics.summarize(rows, rest_window=window).iloc[0]
+    rested = rows[rows["stop_reason"].eq("steady")]
+    at_rest = outcome_statistics.summarize(rested).iloc[0] if len(rested) else None
     low, high = window.tilts(g0)
     moving = int(stats["rest_observed"] - stats["at_rest"])
     out = dict(g0=g0, theta0_deg=theta0, q0=g0 * np.sin(np.radians(theta0)) / 3, sweep=name,
@@ -93,22 +97,23 @@ def cell_row(name, rows, base, window):
     for key in ("rest_observed", "at_rest", "rest_inside", "rest_below", "rest_outside",
                 "p_rest_t10", "p_rest_t10_low", "p_rest_t10_high", "t_rest_median",
                 "t_rest_median_low", "t_rest_median_high", "t_rest_q95", "escape_events",
-                "tail_time", "escape_rate", "escape_rate_low", "escape_rate_high",
-                "p_stable", "p_in_plane", "p_3d", "tilt_q25", "tilt_median", "tilt_q75",
-                "tilt_median_low", "tilt_median_high"):
+                "tail_time", "escape_rate", "escape_rate_low", "escape_rate_high"):
         out[key] = stats[key]
     for key in ("rest_observed", "at_rest", "rest_inside", "rest_below", "rest_outside",
                 "escape_events"):
         out[key] = int(out[key])
+    for key in ("p_stable", "p_in_plane", "p_3d", "tilt_q25", "tilt_median", "tilt_q75",
+                "tilt_median_low", "tilt_median_high"):
+        out[key] = at_rest[key] if at_rest is not None else np.nan
     out["nfev_mean"] = float(rows["nfev"].mean())
     out["wall_s"] = float(rows["wall_s"].sum())
-    if base is not None:
+    if base is not None and len(rested):
         out["baseline"] = base.attrs["name"]
         out["base_seeds"] = len(base)
         out["base_p_steady"] = float(base["stop_reason"].eq("steady").mean())
         out["base_p_3d"] = float(base["regime"].eq("3d").mean())
         out["base_tilt_median"] = float(np.nanmedian(base["theta_final_deg"]))
-        compared = dd.compare_samples(indicators(base), indicators(rows),
+        compared = dd.compare_samples(indicators(base), indicators(rested),
                                       ["is_in_plane", "is_3d"])
         out.update({k: v for k, v in compared.items()
                     if k.startswith("delta_") or k == "verdict"})

@@ -28,15 +28,24 @@ def product_limit(times, at_rest, t):
 SIX_MP = "6 6 6 6+ 7 9+ 10 10+ 11+ 13 16 17+ 19+ 20+ 22 23 25+ 32+ 32+ 34+ 35+".split()
 SIX_MP_TIMES = np.array([float(v.rstrip("+")) for v in SIX_MP])
 SIX_MP_EVENT = np.array([not v.endswith("+") for v in SIX_MP])
-#: the book's Kaplan-Meier column at each event time
+#: the book's Kaplan-Meier column at each event time, and its 95 % log-log limits (the
+#: exponential Greenwood band, as R's survfit(conf.type = "log-log") prints it)
 SIX_MP_KM = {6: 0.857, 7: 0.807, 10: 0.753, 13: 0.690, 16: 0.627, 22: 0.538, 23: 0.448}
+SIX_MP_LOGLOG = {6: (0.620, 0.952), 7: (0.563, 0.923), 10: (0.503, 0.889),
+                 13: (0.432, 0.849), 16: (0.368, 0.805), 22: (0.268, 0.747),
+                 23: (0.188, 0.680)}
 
 
 def test_kaplan_meier_reproduces_the_textbook_table():
     sf, low, high = survival.kaplan_meier(SIX_MP_TIMES, SIX_MP_EVENT)
     for t, expected in SIX_MP_KM.items():
         assert sf.evaluate(t) == pytest.approx(expected, abs=5e-4)
-        assert low.evaluate(t) < expected < high.evaluate(t)
+        assert (low.evaluate(t), high.evaluate(t)) == pytest.approx(SIX_MP_LOGLOG[t], abs=5e-4)
+    # the median 23 weeks, its interval [13, not reached] (R: 23, 13, NA)
+    frame = cell(SIX_MP_TIMES, np.where(SIX_MP_EVENT, "steady", "t_end"))
+    out = survival.settling_statistics(frame)
+    assert (out["t_rest_median"], out["t_rest_median_low"]) == (23.0, 13.0)
+    assert math.isnan(out["t_rest_median_high"])
     curve = survival.survival_curve(SIX_MP_TIMES, SIX_MP_EVENT)
     assert list(curve["t"]) == [0.0, 6, 7, 10, 13, 16, 22, 23]
     assert list(curve["at_risk"]) == [21, 21, 17, 15, 12, 11, 7, 6]
@@ -115,6 +124,23 @@ def test_censoring_before_the_horizon_uses_kaplan_meier():
     assert out["p_rest_t10"] == pytest.approx(expected)
     assert out["p_rest_t10_low"] <= expected <= out["p_rest_t10_high"]
     assert math.isnan(out["t_rest_median"])               # S stays above 1/2
+
+
+def test_what_cannot_be_estimated_is_nan():
+    # every run stopped before t = 10, some still moving: P(at rest by 10) is not known
+    out = survival.settling_statistics(cell([2.0, 8.0, 8.0], ["steady", "t_end", "t_end"]))
+    assert math.isnan(out["p_rest_t10"]) and out["at_rest"] == 1
+    # all at rest before a short t_end: P = 1
+    out = survival.settling_statistics(cell([2.0, 3.0], ["steady", "steady"]))
+    assert out["p_rest_t10"] == 1.0
+    # censored before 10, nobody at rest by 10 (S(10) = 1): no degenerate [0, 0] interval
+    out = survival.settling_statistics(cell([5.0, 12.0, 14.0, 20.0],
+                                            ["t_end", "steady", "steady", "t_end"]))
+    assert out["p_rest_t10"] == 0.0 and math.isnan(out["p_rest_t10_low"])
+    # a NaN time is left out, not a crash
+    out = survival.settling_statistics(cell([4.0, float("nan"), 12.0],
+                                            ["steady", "steady", "t_end"]))
+    assert out["rest_observed"] == 2 and out["p_rest_t10"] == 0.5
 
 
 def test_summarize_adds_the_settling_columns_only_where_rows_were_tested():

@@ -19,11 +19,17 @@ def survival_curves(frame, ax=None, horizon=survival.PAPER_HORIZON):
     """S(t), the share of a cell's loops not yet at rest at time t (Kaplan–Meier, with its
     95 % log-log band shaded), one step curve per (g0, θ0) cell of a results table, a
     tick at each run still moving at its t_end (censored), and the paper's horizon
-    t = 10 dashed.  Returns the figure."""
+    t = 10 dashed.  Cells as ``outcome_statistics.cell_columns`` defines them (cells of
+    rows never tested for rest are left out).  Returns the figure."""
     fig, ax = single_axes(ax, (6.0, 4.0))
+    from ..outcome_statistics import cell_columns, rows_tested
+
     t_last = float(frame["t_final"].max()) if len(frame) else horizon
-    cells = frame.groupby(["g0", "theta0_deg"], sort=True)
-    for colour, ((g0, theta0), rows) in zip(CELL_COLOURS * 10, cells):
+    by = cell_columns(frame)
+    cells = [(key, rows) for key, rows in frame.groupby(by, sort=True, dropna=False)
+             if rows_tested(rows)]   # a --no-early-stop row was never tested for rest
+    for colour, (key, rows) in zip(CELL_COLOURS * 10, cells):
+        g0, theta0 = float(rows["g0"].iloc[0]), float(rows["theta0_deg"].iloc[0])
         times, at_rest = survival.settling_times(rows)
         curve = survival.survival_curve(times, at_rest)
         if len(curve):
@@ -60,8 +66,9 @@ def rest_tilts(frame, window, ax=None):
     fig, ax = single_axes(ax, (max(4.0, 1.2 * len(cells) + 2.0), 4.0))
     for i, ((g0, theta0), rows) in enumerate(cells):
         low, high = window.tilts(g0)
-        ax.fill_between([i - 0.4, i + 0.4], low if low == low else 0.0, high, color="tab:green",
-                        alpha=0.2, linewidth=0, label="stable branch" if i == 0 else None)
+        if low == low:   # (NaN where g0 < 3 q_c: no branch, every rest a circle)
+            ax.fill_between([i - 0.4, i + 0.4], low, high, color="tab:green", alpha=0.2,
+                            linewidth=0, label="stable branch" if i == 0 else None)
         ax.plot([i - 0.4, i + 0.4], [theta0, theta0], color="0.3", linewidth=1,
                 label="initial tilt θ0" if i == 0 else None)
         rested = rows["stop_reason"].eq("steady")

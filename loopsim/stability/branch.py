@@ -210,8 +210,8 @@ def continue_branch(n, q_max, w=DEFAULT_W, side=1, q_min=0.0, max_points=400, st
                     stop_after_fold=False):
     """Pseudo-arclength continuation of the steady shapes from the circle at q_c (module
     docstring), on one side of the circle, until q leaves [q_min, q_max] (or, with
-    ``stop_after_fold``, two points after q first turns back: the fold then lies
-    between the last three points).  Steps (in the norm of (x, q)) grow up to
+    ``stop_after_fold``, two points after q first turns back: the largest q is then the
+    third point from the end, the fold between its neighbours).  Steps (in the norm of (x, q)) grow up to
     ``step_max`` (default STEP_MAX) while Newton needs ≤ 3 iterations, and halve when it
     fails or a guard rejects the point."""
     step_max = STEP_MAX if step_max is None else float(step_max)

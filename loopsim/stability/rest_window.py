@@ -130,8 +130,12 @@ def classify_rest(theta_deg, g0, window):
 
 def _loss_at(shapes, qs, values, sector, tol):
     """The first sign change of ``values`` (leading Re σ of ``sector``) along the
-    branch's shapes, refined by brentq and typed by the eigenvalue there; None if none."""
+    branch's shapes while q still grows (past the fold each q has two shapes, and a
+    bisection in q is ill-posed), refined by brentq and typed by the eigenvalue there;
+    None if none."""
     for i in range(1, len(values)):
+        if qs[i] <= qs[i - 1]:
+            break
         if values[i - 1] < 0.0 <= values[i]:
             q = branch.rate_crossing(shapes[i], qs[i - 1], qs[i], tol, sector=sector)
             shape = branch.solve_steady(shapes[i].x, q, shapes[i].w, symmetric=True)
@@ -195,13 +199,15 @@ def stability_losses(n=DEFAULT_WINDOW_N, w=DEFAULT_W, q_max=80.0, tol=1e-10, cac
     if path is not None and os.path.isfile(path):
         try:
             with open(path, encoding="utf-8") as handle:
-                return _from_record(json.load(handle))
-        except (OSError, ValueError, KeyError, TypeError):
-            pass  # unreadable: computed anew and written over
+                record = json.load(handle)
+            if storage.CONTENT_KEY in record and storage.record_hash_damage(record) is None:
+                return _from_record(record)
+        except (OSError, ValueError, KeyError, TypeError, AttributeError):
+            pass  # unreadable or damaged (its checksum): computed anew and written over
     window = _compute_losses(n, float(w), float(q_max), float(tol))
     if path is not None:
         try:
-            storage.write_json_atomically(window.as_dict(), path)
+            storage.write_record_atomically(window.as_dict(), path)
         except OSError:
             pass  # a read-only cache: the window is still returned
     return window
