@@ -133,7 +133,8 @@ def _figures(frame, cells, seeds_auto):
 
 
 #: The settling columns of the report's per-cell settling table (``loopsim.survival``).
-SETTLING_SHOWN = ("at_rest", "rest_observed", "p_rest_t10", "p_rest_t10_low", "p_rest_t10_high",
+SETTLING_SHOWN = ("at_rest", "rest_observed", "rest_inside", "rest_below", "rest_outside",
+                  "p_rest_t10", "p_rest_t10_low", "p_rest_t10_high",
                   "t_rest_median", "t_rest_median_low", "t_rest_median_high", "t_rest_q95",
                   "escape_events", "escape_rate", "escape_rate_low", "escape_rate_high")
 #: The survival curves are drawn for at most this many cells (one curve each), and only
@@ -154,8 +155,10 @@ def _settling(frame, cells):
              "(stop_reason steady; its settling time is t_final); one still moving at its "
              "t_end is censored there. P(at rest by the paper's horizon t = 10) with its 95 % "
              "interval (Wilson where every run was observed to t = 10, else Kaplan–Meier), "
-             "the Kaplan–Meier median settling time with its interval; NaN: not reached "
-             "within the runs (docs/sweeps.md).</p>",
+             "the Kaplan–Meier median settling time with its interval (NaN: not reached "
+             "within the runs), the escape rate after t = 10 (NaN: fewer than 3 loops came "
+             "to rest after t = 10), and where the loops at rest lie in the stable branch's "
+             "tilt window (docs/sweeps.md).</p>",
              table_html(cells, inputs + [c for c in SETTLING_SHOWN if c in cells], "settling")]
     if len(cells) <= SURVIVAL_CELLS_MAX and frame["t_end"].max() > survival.PAPER_HORIZON:
         fig = figures.survival_curves(frame)
@@ -200,7 +203,12 @@ def report_html(sweep_dir, seed=0, costliest=COSTLIEST):
     stopped = None
     if seeds_auto and os.path.isfile(os.path.join(sweep_dir, storage.STOPS_FILE)):
         stopped = outcome_statistics.stop_counts(storage.read_stop_table(sweep_dir))
-    cells = outcome_statistics.summarize(frame, seed=seed)
+    window = None
+    if "stop_reason" in frame and frame["stop_reason"].eq("steady").any():
+        from .stability import rest_window  # where the loops at rest lie
+
+        window = rest_window.window_for(frame)
+    cells = outcome_statistics.summarize(frame, seed=seed, rest_window=window)
     shown = [c for c in cells.columns if c in outcome_statistics.CELL_INPUTS] + list(CELL_COLUMNS)
     meta = frame.attrs.get("loopsim", {})
     title = f"loopsim report: {os.path.basename(os.path.abspath(sweep_dir))}"

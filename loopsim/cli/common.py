@@ -87,7 +87,9 @@ def add_integration_options(parser):
     """Options shared by every command that integrates loops."""
     add_model_options(parser)
     parser.add_argument("--t-end", type=real, default=DEFAULT_T_END, metavar="T",
-                        help=f"final time, in t_u ({UNITS})")
+                        help=f"final time, in t_u ({UNITS}); with a sweep's early stop a bound: "
+                        "each loop stops once at rest, its settling time in t_final "
+                        "(docs/sweeps.md#run-to-rest)")
     parser.add_argument("--rtol", type=real, default=DEFAULT_RTOL, metavar="RTOL",
                         help="relative tolerance of the time integration (dimensionless); keep "
                         "the default for a run's own tilt. Where loops tumble only the "

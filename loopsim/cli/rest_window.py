@@ -14,8 +14,9 @@ def add_parser(commands):
         "the first loss of stability along it. Prints those losses (Hopf with its frequency "
         "Im sigma in 1/t_u, steady, fold) and, per g0, the window of tilts theta_low <= "
         "theta <= theta_high (degrees) of the stable branch: below it loops rest as circles, "
-        "above it none can rest (loopsim/stability/rest_window.py, docs/stability.md). Local "
-        "model only; about a minute of one core at n = 16.",
+        "above it none can rest (loopsim/stability/rest_window.py, docs/steady-branch.md). "
+        "Local model only; about 20 s of one core at n = 16 the first time, then read back "
+        "from beside the compiled kernels.",
         formatter_class=HelpFormatter,
     )
     window.add_argument("--g0", required=True, metavar="START:STOP:NUM|v1,v2,...",
@@ -48,5 +49,6 @@ def command(args):
     print(f"{'g0':>10} {'theta_low':>10} {'theta_high':>11}  (deg; circles below theta_low)")
     for g in g0:
         low, high = window.tilts(g)
-        print(f"{g:>10.4f} {low:>10.4f} {high:>11.4f}")
+        low_text = "none" if low != low else f"{low:.4f}"   # NaN: no branch at this g0
+        print(f"{g:>10.4f} {low_text:>10} {high:>11.4f}")
     return 0

@@ -14,8 +14,10 @@ def add_parser(commands):
         "a terminal state reached before --t-end; empty, unknown, for a sweep run with "
         "--no-early-stop), each regime's "
         "probability with its Wilson interval, the median and quartiles of the terminal "
-        "tilt and aspect ratio with bootstrap intervals of the medians, and the cost "
-        "(loopsim/outcome_statistics.py).",
+        "tilt and aspect ratio with bootstrap intervals of the medians, how long the loops "
+        "took to come to rest (P(at rest by t = 10), the median settling time, the escape "
+        "rate; docs/sweeps.md#run-to-rest) and where they rest against the stable branch's "
+        "tilt window, and the cost (loopsim/outcome_statistics.py).",
         formatter_class=HelpFormatter,
     )
     summary.add_argument("sweep_dir", metavar="SWEEP_DIR", help="a sweep directory")
@@ -37,7 +39,12 @@ def command(args):
         if path is not None:
             validation.check_output_file(name, path)
     frame = storage.read_results(args.sweep_dir)
-    table = outcome_statistics.summarize(frame, seed=args.seed)
+    window = None
+    if "stop_reason" in frame and frame["stop_reason"].eq("steady").any():
+        from ..stability import rest_window  # where the loops at rest lie
+
+        window = rest_window.window_for(frame)
+    table = outcome_statistics.summarize(frame, seed=args.seed, rest_window=window)
     if args.figure is not None:  # refused before anything is written
         from .. import figures
 
@@ -47,7 +54,8 @@ def command(args):
         c for c in ("seeds", "determined", "steady") if c in table] + [
         "p_stable", "p_in_plane", "p_3d", "p_3d_low", "p_3d_high",
         "tilt_median", "tilt_median_low", "tilt_median_high"] + [
-        c for c in ("at_rest", "p_rest_t10", "t_rest_median") if c in table]
+        c for c in ("at_rest", "p_rest_t10", "t_rest_median", "rest_inside", "rest_below",
+                    "rest_outside") if c in table]
     print_and_write(table, args.out, dict(table.attrs["loopsim_summary"],
                                            summary_of=directory_name(args.sweep_dir),
                                            perturbation_ensemble=PERTURBATION_ENSEMBLE),

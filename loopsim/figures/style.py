@@ -178,11 +178,9 @@ def rest_window_for(frame):
     """The stable branch's window (``stability.rest_window.stability_losses``, computed once
     per machine and code version) for a local-model table, None for another model (its
     branch is not continued): what the phase diagrams take as ``rest_window``."""
-    if frame_model(frame).name != "local":
-        return None
     from ..stability import rest_window
 
-    return rest_window.stability_losses()
+    return rest_window.window_for(frame)
 
 
 def rest_window_curve(ax, window, theta):

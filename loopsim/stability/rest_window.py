@@ -36,7 +36,7 @@ from ..defaults import DEFAULT_W
 from . import branch
 
 __all__ = ["StabilityLoss", "RestWindow", "stability_losses", "rest_window", "tilt_window",
-           "classify_rest", "DEFAULT_WINDOW_N", "REST_CLASSES"]
+           "classify_rest", "window_for", "DEFAULT_WINDOW_N", "REST_CLASSES"]
 
 #: Truncation order of the window: q_loss_out_of_plane within 4e-7 of n = 24
 #: (docs/stability.md §5).
@@ -231,6 +231,14 @@ def _compute_losses(n, w, q_max, tol):
         raise ValueError(f"no loss of stability along the branch up to q = {q_max} at n = {n}")
     return RestWindow(n=n, w=w, q_circle=float(half.q_circle),
                       losses=tuple(sorted(losses, key=lambda loss: loss.q)))
+
+
+def window_for(frame):
+    """The window to count a results table's loops at rest against
+    (``summarize(..., rest_window=...)``, the phase diagrams): :func:`stability_losses`
+    for a local-model table, None for another model (its branch is not continued)."""
+    models = set(frame["model"].dropna()) if "model" in frame else set()
+    return stability_losses() if models <= {"local"} else None
 
 
 def rest_window(g0, n=DEFAULT_WINDOW_N, w=DEFAULT_W):
