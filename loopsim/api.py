@@ -165,7 +165,7 @@ def simulate(
     steady_tol : float or None, default None
         Stop early once the shape and tilt change by less than this (dimensionless) per
         ``steady_interval``; None: integrate to ``t_span[1]``.  Unlike
-        :func:`loopsim.sweep` (``early_stop=True``), a single run does not stop early by
+        ``loopsim.sweep`` (``early_stop=True``), a single run does not stop early by
         default: it is asked for its states at the requested times (``t_eval``,
         ``snapshots``, as ``solve_ivp``), and an early stop would leave the later ones out
         (``t_missed``).  ``steady_tol=loopsim.defaults.DEFAULT_STEADY_TOL`` (1e-6) stops

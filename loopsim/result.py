@@ -1,4 +1,4 @@
-"""The result of :func:`loopsim.simulate`: :class:`SimulationResult`, its summary fields,
+"""The result of ``loopsim.simulate``: :class:`SimulationResult`, its summary fields,
 and :class:`LoopsimWarning`, the warning of a result that needs care.  No integration
 here (``loopsim.api`` runs it)."""
 import dataclasses

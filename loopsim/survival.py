@@ -14,7 +14,7 @@ survival of "not yet at rest" is the Kaplan–Meier product
     S(t) = ∏_{t_j ≤ t} (1 − d_j / r_j)      (r_j: runs still observed just before t_j)
 
 (``scipy.stats.ecdf`` on ``scipy.stats.CensoredData``), with the 95 % exponential
-Greenwood ("log-log") band.  Per cell (:func:`settling_statistics`):
+Greenwood ("log-log") band.  Per cell (``settling_statistics``):
 
 * ``p_rest_t10``: P(at rest by the paper's horizon t = 10) = 1 − S(10), with its
   95 % interval: the Wilson interval where every run was observed to at least t = 10
@@ -36,7 +36,7 @@ Greenwood ("log-log") band.  Per cell (:func:`settling_statistics`):
 A survival that falls to zero within the runs' horizon is a transient; one that levels
 off at S > 0 with runs censored at a long t_end is a lasting motion (tumbling, or a slow
 approach where the decay rate vanishes, as at the edges of the stable window) or a
-transient longer than that horizon: :func:`survival_curve` gives the curve and band,
+transient longer than that horizon: ``survival_curve`` gives the curve and band,
 ``terminal_state`` and the ``late_*`` columns say which motion.
 """
 import math
@@ -52,7 +52,7 @@ PAPER_HORIZON = 10.0
 MIN_TAIL_EVENTS = 3
 #: Confidence level of every interval here.
 LEVEL = 0.95
-#: The columns :func:`settling_statistics` returns, in order.
+#: The columns ``settling_statistics`` returns, in order.
 SETTLING_COLUMNS = ("rest_observed", "at_rest", "p_rest_t10", "p_rest_t10_low",
                     "p_rest_t10_high", "t_rest_median", "t_rest_median_low",
                     "t_rest_median_high", "t_rest_q95", "escape_events", "tail_time",

@@ -66,7 +66,7 @@ class StabilityLoss:
 class RestWindow:
     """The stable stretch of the branch in q: from ``q_circle`` (the circle's in-plane
     threshold, where the branch starts) to ``q_loss`` (the first of ``losses``), at
-    truncation ``n`` and penalty ``w``.  :meth:`tilts` turns it into tilts at a g0."""
+    truncation ``n`` and penalty ``w``.  ``tilts`` turns it into tilts at a g0."""
 
     n: int
     w: float
@@ -84,7 +84,7 @@ class RestWindow:
         a circle); θ_high is 90 where even θ = 90° stays below the first loss."""
         return tilt_window(g0, self.q_circle, self.q_loss)
 
-    #: Where a settled loop lies relative to the window (:meth:`classify`).
+    #: Where a settled loop lies relative to the window (``classify``).
     CLASSES = REST_CLASSES
 
     def classify(self, theta_deg, g0):
@@ -169,7 +169,7 @@ WINDOW_SOURCES = ("stability/rest_window.py", "stability/branch.py", "stability/
 def _cache_path(n, w, q_max, tol):
     """Where a computed window is kept: the kernels' cache directory
     (``loopsim._jitcache.cache_dir``), under a name holding a hash of
-    :data:`WINDOW_SOURCES` and the arguments."""
+    ``WINDOW_SOURCES`` and the arguments."""
     sources = [os.path.join(_jitcache.PACKAGE_DIR, *name.split("/")) for name in WINDOW_SOURCES]
     return os.path.join(_jitcache.cache_dir(),
                         f"rest-window-{_jitcache.source_hash(sources)}-n{n}-w{w!r}-q{q_max!r}"
@@ -190,7 +190,7 @@ def _from_record(record):
 def stability_losses(n=DEFAULT_WINDOW_N, w=DEFAULT_W, q_max=80.0, tol=1e-10, cache=True):
     """The losses of stability along the branch's in-plane-stable half, in order of q:
     the first out-of-plane and in-plane crossings (Hopf or steady) and the fold, as a
-    :class:`RestWindow`.  About 20 s of one core at n = 16; once computed it is kept
+    ``RestWindow``.  About 20 s of one core at n = 16; once computed it is kept
     beside the compiled kernels (``cache``; a change to the code it depends on computes it
     anew) and read back in milliseconds."""
     n = validation.check_count("n", n, 4, validation.MAX_BRANCH_N,
@@ -235,7 +235,7 @@ def _compute_losses(n, w, q_max, tol):
 
 def window_for(frame):
     """The window to count a results table's loops at rest against
-    (``summarize(..., rest_window=...)``, the phase diagrams): :func:`stability_losses`
+    (``summarize(..., rest_window=...)``, the phase diagrams): ``stability_losses``
     for a local-model table, None for another model (its branch is not continued)."""
     models = set(frame["model"].dropna()) if "model" in frame else set()
     return stability_losses() if models <= {"local"} else None
@@ -243,7 +243,7 @@ def window_for(frame):
 
 def rest_window(g0, n=DEFAULT_WINDOW_N, w=DEFAULT_W):
     """The tilts (θ_low, θ_high), in degrees, at which a loop at ``g0`` can rest on the
-    stable steady branch (module docstring), with the :class:`RestWindow` they come from.
+    stable steady branch (module docstring), with the ``RestWindow`` they come from.
 
     Examples
     --------

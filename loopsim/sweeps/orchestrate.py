@@ -186,7 +186,7 @@ def sweep(g0, theta0_deg, out, *, n="auto", seeds=1, method=None, t_end=DEFAULT_
     early_stop : bool, default True
         Stop a case once its shape and tilt are steady (``steady_tol`` per
         ``steady_interval``; docs/sweeps.md): a sweep wants each case's terminal state,
-        not its states at later times.  :func:`loopsim.simulate` integrates to the end by
+        not its states at later times.  ``loopsim.simulate`` integrates to the end by
         default instead (its ``steady_tol=None``): a single run returns its states at the
         requested times.
     n_max : int, default 32
