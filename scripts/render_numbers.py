@@ -317,6 +317,7 @@ def _rest_study():
             out[f"{key}.base-p10"] = f"{r['base_p_steady']:.2f}"
     out["rest.study-table"] = "\n\n" + "\n".join(rows) + "\n\n"
     out["rest.cells"] = count(len(frame))
+    out["rest.loops-at-rest"] = count(frame["at_rest"].sum())
     return out
 
 
