@@ -101,7 +101,8 @@ def _add_output_options(output):
     output.add_argument("--chunk-size", type=int, default=None, metavar="K",
                        help="cases per chunk file (and per Dask task; default "
                        f"{DEFAULT_CHUNK_SIZE}, or {DEFAULT_AUTO_CHUNK_SIZE} with --n auto, "
-                       "whose cases take minutes: a SIGKILL loses the unwritten chunks); may "
+                       "whose cases take seconds to minutes: a SIGKILL loses the unwritten "
+                       "chunks); may "
                        "change on resume")
     output.add_argument("--out", metavar="DIR",
                        help="sweep directory, made if absent (required, except with "
