@@ -64,7 +64,9 @@ work_precision (docs/studies/performance.md) runs ``benchmarks/bench_trajectory.
 runs ``scripts/paper_range_study.py``, which also writes its tables into data/;
 paper_range_top redraws the top of that range from the sweeps committed under
 data/paper_range_runs (``paper_range_study.py --top --read-only``: the parts themselves
-take hours each and run apart, see docs/studies/paper-range.md).  Fig. 3 and
+take hours each and run apart, see docs/studies/paper-range.md); rest_survival and
+rest_tilts redraw the run-to-rest study from data/rest_runs (``rest_study.py
+--read-only``, docs/studies/rest.md).  Fig. 3 and
 nonlocal_thresholds (the circle's critical q against ε) need no run.  Nothing
 here is random beyond the seeded initial perturbations
 (seed 0 unless stated), so a rerun reproduces the tables.
@@ -255,6 +257,8 @@ def targets(quick=False):
         "work_precision": ([], ("benchmark",)),
         "paper_range": ([], ("study",)),
         "paper_range_top": ([], ("study_top",)),
+        "rest_survival": ([], ("rest_study",)),
+        "rest_tilts": ([], ("rest_study",)),
         "seed_distributions": (["seeds_n6", "seeds_auto"],
                                ("figures", "seeds_n6", ["seeds_n6", "seeds_auto"], "seeds",
                                 "seed_distributions")),
@@ -348,6 +352,16 @@ def draw(name, how, paths, out, work, quick):
             command = [sys.executable, script, "--top", "--read-only", "--figure", target,
                        "--data", data]
         print("$ " + " ".join(shlex.quote(a) for a in command), flush=True)
+        os.makedirs(out, exist_ok=True)
+        subprocess.run(command, check=True)
+    elif kind == "rest_study":  # the run-to-rest study's two figures, from its committed runs
+        script = os.path.join(os.path.dirname(__file__), "rest_study.py")
+        table = os.path.join(work, "rest_study.parquet") if quick else \
+            os.path.join("data", "rest_study.parquet")
+        command = [sys.executable, script, "--read-only", "--out", table, "--figures", out,
+                   *(["--window-n", "8"] if quick else [])]
+        print("$ " + " ".join(shlex.quote(a) for a in command), flush=True)
+        os.makedirs(work, exist_ok=True)
         os.makedirs(out, exist_ok=True)
         subprocess.run(command, check=True)
     elif kind == "stability":
