@@ -21,7 +21,7 @@ Internals, each layer importing only those before it (tests/test_layout.py check
 every module is named here and that no import goes to a later layer; docs/extending.md's
 module table is made from this list): ``_version``, ``_signals``, ``_moved``,
 ``_jitcache``, ``_blas``, ``defaults``, ``exit_codes``, ``render_defaults``, ``columns``,
-``spectral``; ``jit``, ``validation``, ``diagnostics``; ``dispatch``, ``linalg``,
+``spectral``; ``jit``, ``validation``, ``diagnostics``, ``intervals``; ``dispatch``, ``linalg``,
 ``outcomes``, ``survival``, ``storage``; ``models``, ``outcome_statistics``, ``shapes``, ``late_motion``; ``integrators``,
 ``seeds_auto_rule``, ``distribution_differences``, ``stability``; ``batch``, ``figures``, ``result``; ``refinement``,
 ``sweep_report``; ``api``; ``sweeps``; ``cli``, ``ensemble``; ``__main__``.

@@ -33,7 +33,7 @@ Plain NumPy and SciPy: nothing here integrates.
 import numpy as np
 from scipy.stats import binom, norm
 
-from .outcome_statistics import percentile_bootstrap, wilson_interval
+from .intervals import percentile_bootstrap, wilson_interval
 
 #: Probability of detecting a difference of the stated size (the power of ``*_detectable``).
 POWER = 0.8

@@ -46,6 +46,8 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
+from .intervals import wilson_interval
+
 #: The paper's horizon, t = 10 t_u: P(at rest by then), and the start of the tail.
 PAPER_HORIZON = 10.0
 #: Fewest runs coming to rest after the horizon for an escape rate.
@@ -145,9 +147,9 @@ def settling_statistics(frame, horizon=PAPER_HORIZON, level=LEVEL):
         return out
     rested_by = int(np.sum(at_rest & (times <= horizon)))
     if np.all(at_rest & (times <= horizon) | (times >= horizon)):
-        interval = stats.binomtest(rested_by, times.size).proportion_ci(level, method="wilson")
         out["p_rest_t10"] = rested_by / times.size
-        out["p_rest_t10_low"], out["p_rest_t10_high"] = interval.low, interval.high
+        out["p_rest_t10_low"], out["p_rest_t10_high"] = wilson_interval(rested_by, times.size,
+                                                                        level)
     km = kaplan_meier(times, at_rest, level)
     if km is not None:
         sf, low, high = km

@@ -142,7 +142,7 @@ SETTLING_SHOWN = ("at_rest", "rest_observed", "rest_inside", "rest_below", "rest
 SURVIVAL_CELLS_MAX = 10
 
 
-def _settling(frame, cells):
+def settling_section(frame, cells):
     """The settling section: per cell, how many came to rest, P(at rest by t = 10), the
     median settling time and the escape rate (``loopsim.survival``), and the survival
     curves of a run-to-rest sweep; empty where the rows were not tested for rest."""
@@ -219,7 +219,7 @@ def report_html(sweep_dir, seed=0, costliest=COSTLIEST):
         _provenance(meta, sweep_dir),
         _counts(outcome_statistics.outcome_counts(frame), stopped),
         _figures(frame, cells, seeds_auto),
-        _settling(frame, cells),
+        settling_section(frame, cells),
         _failed(frame, sweep_dir),
         _cost(frame, costliest),
         f"<h2>Per cell</h2><p>One row per cell (<code>loopsim summary {html.escape(sweep_dir)}"

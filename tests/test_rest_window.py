@@ -103,7 +103,7 @@ def test_a_computed_window_is_kept_and_read_back(tmp_path, monkeypatch):
     monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
     compute = rw.stability_losses.__wrapped__            # past the in-process lru_cache
     first = compute(8)
-    path = rw._cache_path(8, 10.0, 80.0, 1e-10)
+    path = rw.cache_path(8, 10.0, 80.0, 1e-10)
     assert os.path.isfile(path) and str(tmp_path) in path
     assert compute(8).as_dict() == first.as_dict()        # read back: the same losses
     with open(path, "w", encoding="utf-8") as handle:

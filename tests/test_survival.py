@@ -178,5 +178,5 @@ def test_survival_figure_and_report_section():
     figures.rest_tilts(frame, window)
     cells = outcome_statistics.summarize(frame, rest_window=window)
     assert list(cells["rest_inside"]) == [2, 2] and list(cells["rest_below"]) == [0, 1]
-    html = sweep_report._settling(frame, cells)
+    html = sweep_report.settling_section(frame, cells)
     assert "<h2>Settling</h2>" in html and "data:image/png" in html

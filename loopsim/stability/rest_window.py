@@ -166,7 +166,7 @@ WINDOW_SOURCES = ("stability/rest_window.py", "stability/branch.py", "stability/
                   "stability/full_linear.py")
 
 
-def _cache_path(n, w, q_max, tol):
+def cache_path(n, w, q_max, tol):
     """Where a computed window is kept: the kernels' cache directory
     (``loopsim._jitcache.cache_dir``), under a name holding a hash of
     ``WINDOW_SOURCES`` and the arguments."""
@@ -195,7 +195,7 @@ def stability_losses(n=DEFAULT_WINDOW_N, w=DEFAULT_W, q_max=80.0, tol=1e-10, cac
     anew) and read back in milliseconds."""
     n = validation.check_count("n", n, 4, validation.MAX_BRANCH_N,
                                "the continuation's cost grows like n^3 per point")
-    path = _cache_path(n, float(w), float(q_max), float(tol)) if cache else None
+    path = cache_path(n, float(w), float(q_max), float(tol)) if cache else None
     if path is not None and os.path.isfile(path):
         try:
             with open(path, encoding="utf-8") as handle:
