@@ -190,28 +190,29 @@ def check_places(args):
              "the sweeps, or --read-only to tabulate the finished ones)")
 
 
+#: The columns that name a row of the convergence table.
+ROW_KEY = ("g0", "theta0_deg", "setting")
+
+
 def row_keys(frame):
     """The (g0, θ0, setting) rows of a convergence table, rounded past the last bit."""
-    return {(round(float(g), 9), round(float(t), 9), str(s))
-            for g, t, s in zip(frame["g0"], frame["theta0_deg"], frame["setting"])}
+    return storage.study_keys(frame, ROW_KEY)
 
 
 def sweep_keys(setting, g0, theta0):
     """The rows a sweep of ``setting`` over ``g0`` (comma-separated) at ``theta0`` gives."""
-    return {(round(float(g), 9), round(float(theta0), 9), setting) for g in g0.split(",")}
+    values = g0.split(",")
+    return storage.study_keys({"g0": values, "theta0_deg": [float(theta0)] * len(values),
+                               "setting": [setting] * len(values)}, ROW_KEY)
 
 
 def refuse_if_shrinking(out, keys, runs):
     """Exit (one line, status 2) where the table at ``out`` holds rows that ``keys`` lacks:
     a partial run never replaces a fuller table."""
-    if not os.path.isfile(out):
-        return
     try:
-        have = row_keys(pd.read_parquet(out, columns=["g0", "theta0_deg", "setting"]))
-    except Exception as exc:  # noqa: BLE001 - an unreadable table is kept as it is
-        fail(f"{out!r} cannot be read to compare its rows ({exc}): nothing written over it; "
-             "give --out another place")
-    lost = have - keys
+        have, lost = storage.keys_a_write_would_drop(out, keys, ROW_KEY)
+    except ValueError as exc:
+        fail(f"{exc}: nothing written over it; give --out another place")
     if lost:
         fail(f"the finished sweeps in {runs!r} give {len(have) - len(lost)} of the "
              f"{len(have)} rows (cell and setting) of {out!r}: writing would drop "

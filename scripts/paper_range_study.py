@@ -214,8 +214,7 @@ def cell_keys(frame):
     """The cells (g0, θ0) of a table or of a part's grid, as a set of rounded pairs (the
     values are the grid's own, :data:`G0`, :data:`THETA0`: rounding only spares them
     the last bit)."""
-    return {(round(float(g), 9), round(float(t), 9))
-            for g, t in zip(frame["g0"], frame["theta0_deg"])}
+    return storage.study_keys(frame, ("g0", "theta0_deg"))
 
 
 def expected_cells(args, parts, to_run):
@@ -254,14 +253,12 @@ def shrinking(args, cells):
               (os.path.join(args.data, args.stops_file), "--data"),
               (committed_figure_table(args), "--figure")]
     for path, option in places:
-        if path is None or not os.path.isfile(path):
+        if path is None:
             continue
         try:
-            have = cell_keys(pd.read_parquet(path, columns=["g0", "theta0_deg"]))
-        except Exception as exc:  # noqa: BLE001 - any unreadable table is kept as it is
-            return (f"{path!r} cannot be read to compare its cells ({exc}): nothing written "
-                    f"over it; give {option} another place")
-        lost = have - cells
+            have, lost = storage.keys_a_write_would_drop(path, cells, ("g0", "theta0_deg"))
+        except ValueError as exc:
+            return f"{exc}: nothing written over it; give {option} another place"
         if lost:
             what = (f"{path!r}" if option == "--data"
                     else f"the figure {args.figure!r} (it draws {path!r})")

@@ -129,18 +129,18 @@ def tabulate(frames, bases, window):
 def refuse_to_shrink(table, out):
     """Exit 2 if ``out`` holds a cell that ``table`` lacks (a partial run would shrink a
     committed table)."""
-    if not os.path.exists(out):
-        return
+    cells = ("g0", "theta0_deg")
     try:
-        old = pd.read_parquet(out, columns=["g0", "theta0_deg"])
-    except (OSError, ValueError) as exc:
-        sys.exit(f"rest_study: cannot read the existing {out} to compare: {exc}")
-    keys = set(zip(table["g0"], table["theta0_deg"]))
-    lost = [k for k in zip(old["g0"], old["theta0_deg"]) if k not in keys]
+        held, lost = storage.keys_a_write_would_drop(out, storage.study_keys(table, cells), cells)
+    except ValueError as exc:
+        print(f"rest_study: error: {exc}: nothing written over it; give another --out",
+              file=sys.stderr)
+        sys.exit(2)
     if lost:
-        print(f"rest_study: error: {out} holds {len(old)} cells, this run only {len(table)} "
-              f"(e.g. g0 = {lost[0][0]:g}, theta0 = {lost[0][1]:g} is missing); "
-              "give another --out", file=sys.stderr)
+        g0, theta0 = sorted(lost)[0]
+        print(f"rest_study: error: {out} holds {len(held)} cells, this run only {len(table)} "
+              f"(e.g. g0 = {g0:g}, theta0 = {theta0:g} is missing); give another --out",
+              file=sys.stderr)
         sys.exit(2)
 
 

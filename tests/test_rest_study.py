@@ -64,3 +64,19 @@ def test_refuses_to_shrink_a_table(runs):
     done = run_study(runs, out)
     assert done.returncode == 2 and "holds 2 cells, this run only 1" in done.stderr
     assert len(pd.read_parquet(out)) == 2
+
+
+def test_the_keys_a_write_would_drop(tmp_path):
+    """The check every study script makes before it writes (storage.keys_a_write_would_drop)."""
+    from loopsim import storage
+
+    path = tmp_path / "t.parquet"
+    cells = ("g0", "theta0_deg")
+    assert storage.keys_a_write_would_drop(str(path), set(), cells) == (set(), set())
+    pd.DataFrame(dict(g0=[350.0, 325.7142857142857], theta0_deg=[18.0, 18.0])).to_parquet(path)
+    one = storage.study_keys(dict(g0=[350.0], theta0_deg=[18]), cells)
+    held, dropped = storage.keys_a_write_would_drop(str(path), one, cells)
+    assert len(held) == 2 and dropped == {(325.714285714, 18.0)}
+    path.write_bytes(b"not parquet")
+    with pytest.raises(ValueError, match="cannot be read"):
+        storage.keys_a_write_would_drop(str(path), one, cells)

@@ -31,7 +31,8 @@ from .seedsdir import (
 )
 from .tables import (
     COEFFICIENT_LAYOUT, INPUT_FIELDS, MOTION_FIELDS, OUTCOME_FIELDS, RESULT_SCHEMA, RUN_FIELDS, SUMMARY_FIELDS,
-    coefficients, described, provenance, read_metadata, trajectory_table, write_trajectory,
+    coefficients, described, keys_a_write_would_drop, provenance, read_metadata, study_keys,
+    trajectory_table, write_trajectory,
 )
 
 __all__ = [
@@ -49,4 +50,5 @@ __all__ = [
     "read_seeds_file", "read_stop_table", "record_damage", "round_directory",
     "write_seeds_file", "record_hash", "record_hash_damage", "write_record_atomically",
     "write_file_atomically", "write_table_atomically", "write_trajectory",
+    "study_keys", "keys_a_write_would_drop",
 ]

@@ -2,6 +2,7 @@
 every table carries, a run's trajectory table, and reading a file's metadata back."""
 import datetime
 import json
+import numbers
 import os
 import platform
 import socket
@@ -166,3 +167,27 @@ def read_metadata(path):
         except json.JSONDecodeError:
             out[key] = value
     return out
+
+
+# ---- study tables: a partial run never replaces a fuller table -------------------------
+def study_keys(frame, key_columns):
+    """The rows of a study table (or a grid's columns: any mapping of equal-length columns)
+    as a set of keys over ``key_columns``: numbers rounded to 9 decimals (past the last
+    bit of the grids' values), anything else as text."""
+    return {tuple(round(float(v), 9) if isinstance(v, numbers.Real) else str(v) for v in row)
+            for row in zip(*(frame[c] for c in key_columns))}
+
+
+def keys_a_write_would_drop(path, keys, key_columns):
+    """(held, dropped): the keys (:func:`study_keys`) of the table at ``path`` and those of
+    them missing from ``keys``, what writing a table of ``keys`` over it would lose; two
+    empty sets where there is no file.  ValueError (one line) where the table cannot be
+    read: it is then kept as it is."""
+    if not os.path.isfile(path):
+        return set(), set()
+    try:
+        held = study_keys(pq.read_table(path, columns=list(key_columns)).to_pandas(),
+                          key_columns)
+    except Exception as exc:  # noqa: BLE001 - any unreadable table is kept as it is
+        raise ValueError(f"{path!r} cannot be read to compare its rows ({exc})") from None
+    return held, held - set(keys)
