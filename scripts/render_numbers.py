@@ -273,6 +273,31 @@ def _interval(value, low, high, digits, unit=""):
     return f"{value:.{digits}f}{unit} [{ends}]"
 
 
+def _rest_range():
+    """The paper's empty cells run to rest as far as they got
+    (``data/paper_range_rest_summary.parquet``: ``loopsim summary`` of the
+    ``data/rest_runs/range_rest_t*`` sweeps): ``rest.range-table``, ``rest.range-cells``."""
+    path = os.path.join(DATA, "paper_range_rest_summary.parquet")
+    if not os.path.exists(path):
+        return {}
+    frame = pd.read_parquet(path)
+    rows = ["| g0, θ0 | seeds | P(3D) | at rest by t = 40 | P(at rest by t = 10) "
+            "| median settling time | at rest: inside / below / outside | median tilt (deg) |",
+            "|---|--:|--:|--:|---|---|--:|---|"]
+    for _, r in frame.iterrows():
+        rows.append(f"| ({r['g0']:.1f}, {r['theta0_deg']:.0f}°) | {int(r['seeds'])} | "
+                    f"{r['p_3d']:.2f} | {int(r['at_rest'])} of {int(r['rest_observed'])} | "
+                    + _interval(r["p_rest_t10"], r["p_rest_t10_low"], r["p_rest_t10_high"], 2)
+                    + " | " + _interval(r["t_rest_median"], r["t_rest_median_low"],
+                                        r["t_rest_median_high"], 1)
+                    + f" | {int(r['rest_inside'])} / {int(r['rest_below'])} / "
+                      f"{int(r['rest_outside'])} | "
+                    + _interval(r["tilt_median"], r["tilt_median_low"], r["tilt_median_high"], 1)
+                    + " |")
+    return {"rest.range-table": "\n\n" + "\n".join(rows) + "\n\n",
+            "rest.range-cells": count(len(frame))}
+
+
 def _rest_study():
     """Per cell of the run-to-rest study: ``rest.<g0>-<theta0>.<statistic>``, and the
     table of every cell (``rest.study-table``)."""
@@ -318,6 +343,7 @@ def _rest_study():
     out["rest.study-table"] = "\n\n" + "\n".join(rows) + "\n\n"
     out["rest.cells"] = count(len(frame))
     out["rest.loops-at-rest"] = count(frame["at_rest"].sum())
+    out.update(_rest_range())
     return out
 
 
