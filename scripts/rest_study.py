@@ -31,8 +31,11 @@ t = 10 ones.
 Each cell is one ``loopsim sweep``, run by the ``--loopsim`` executable (a frozen
 install keeps the study on one version of the code; the code each ran on is in
 ``STUDY_COMMITS.json`` beside the sweeps), resumable; ``--read-only`` tabulates what has
-finished (a sweep with fewer than 16 rows is left out).  A table never shrinks: the
-script refuses to overwrite ``--out`` with one that lacks a cell it holds.  It writes
+finished (a sweep with fewer than 16 rows is left out).  The paper's empty cells above
+g0 = 250, run to rest with 8 seeds in one sweep per tilt (``range_rest_t<θ0>``, queued
+apart: docs/studies/rest.md), are summarised into ``--range-out`` as they finish.  A
+table never shrinks: the script refuses to overwrite a table with one that lacks a cell
+it holds.  It writes
 the table (columns: ``loopsim.columns.REST_STUDY_COLUMNS``) and two figures:
 ``rest_survival.png`` (the survival curves) and ``rest_tilts.png`` (tilts at rest over
 the window).
@@ -126,6 +129,42 @@ def tabulate(frames, bases, window):
     return pd.DataFrame(table).sort_values(["theta0_deg", "g0"], ignore_index=True)
 
 
+#: The paper's empty cells above g0 = 250, run to rest: one sweep per tilt, 8 seeds each
+#: (``data/rest_runs/range_rest_t<theta0>``), tabulated into :data:`RANGE_OUT`.
+RANGE_THETA0 = (36, 42, 48, 54, 60, 66, 72, 78, 84, 90)
+RANGE_SEEDS = 8
+RANGE_OUT = os.path.join("data", "paper_range_rest_summary.parquet")
+
+
+def tabulate_range(runs, out, window):
+    """``loopsim.summarize`` of every finished range sweep in ``runs`` (with the rest
+    window), written to ``out`` as a summary table (``SUMMARY_COLUMNS``); a table that
+    would lose cells is refused like the study's own."""
+    frames = []
+    for theta0 in RANGE_THETA0:
+        path = os.path.join(runs, f"range_rest_t{theta0}")
+        try:
+            frame = loopsim.read_results(path)
+        except (FileNotFoundError, ValueError):
+            continue
+        if len(frame) < RANGE_SEEDS * len(G0[10:]):
+            print(f"range_rest_t{theta0}: {len(frame)} of {RANGE_SEEDS * len(G0[10:])} cases, "
+                  "left out")
+            continue
+        frames.append(frame)
+    if not frames:
+        return
+    table = outcome_statistics.summarize(pd.concat(frames, ignore_index=True),
+                                         rest_window=window)
+    refuse_to_shrink(table, out)
+    arrow = pa.Table.from_pandas(table, preserve_index=False)
+    arrow = arrow.replace_schema_metadata(storage.provenance(loopsim_summary=json.dumps(
+        dict(table.attrs["loopsim_summary"], summary_of="data/rest_runs/range_rest_t*",
+             ensemble=ENSEMBLE.replace("0-15", f"0-{RANGE_SEEDS - 1}")))))
+    storage.write_table_atomically(storage.described(arrow, columns.SUMMARY_COLUMNS), out)
+    print(f"wrote {out}: {len(table)} cells")
+
+
 def refuse_to_shrink(table, out):
     """Exit 2 if ``out`` holds a cell that ``table`` lacks (a partial run would shrink a
     committed table)."""
@@ -155,6 +194,9 @@ def main():
                         help="directory of rest_survival.png and rest_tilts.png")
     parser.add_argument("--read-only", action="store_true",
                         help="run nothing: tabulate the sweeps that have finished")
+    parser.add_argument("--range-out", default=RANGE_OUT,
+                        help="the summary of the paper's empty cells run to rest (the finished "
+                             "range_rest_t* sweeps in --runs)")
     parser.add_argument("--window-n", type=int, default=rest_window.DEFAULT_WINDOW_N,
                         help="truncation order of the steady branch whose window is used")
     args = parser.parse_args()
@@ -205,6 +247,7 @@ def main():
     rows = pd.concat(frames.values(), ignore_index=True)
     figures.save(figures.survival_curves(rows), os.path.join(args.figures, "rest_survival.png"))
     figures.save(figures.rest_tilts(rows, window), os.path.join(args.figures, "rest_tilts.png"))
+    tabulate_range(args.runs, args.range_out, window)
     with pd.option_context("display.width", 220, "display.max_columns", 40):
         shown = ["g0", "theta0_deg", "q0", "seeds", "at_rest", "moving_at_t_max",
                  "p_rest_t10", "t_rest_median", "t_rest_q95", "rest_inside", "rest_below",
