@@ -1,8 +1,12 @@
 """Output paths a thousand directories deep (2 003 characters, legal on Linux: PATH_MAX is
 4 096) are made without recursion (``storage.make_directories``); longer ones than the
-system takes are a one-line error.  Issue 54.9: ``os.makedirs`` recursed once per level
-and ``sweep``, ``run``, ``report``, ``summary``, ``animate`` and ``figures`` ended in a
-RecursionError traceback."""
+system takes are a one-line error that leaves no directories behind.  Issue 54.9:
+``os.makedirs`` recursed once per level and ``sweep``, ``run``, ``report``, ``summary``,
+``animate`` and ``figures`` ended in a RecursionError traceback.
+
+Each test removes its deep trees itself: pytest's own clean-up (``shutil.rmtree``, recursive
+on Python 3.11) cannot, and a tree left in the temporary root failed the next session's
+clean-up with a RecursionError after every test had passed."""
 import os
 
 import pytest
@@ -24,7 +28,23 @@ def deep(tmp_path_factory):
                  "--quiet", "--out", sweep]) == 0
     assert main(["run", "--g0", "10", "--theta0", "30", "--n", "6", "--t-end", "0.05",
                  "--out", run]) == 0
-    return dict(root=str(root), sweep=sweep, run=run)
+    yield dict(root=str(root), sweep=sweep, run=run)
+    remove_tree(str(root))
+
+
+def remove_tree(root):
+    """``shutil.rmtree`` without recursion: an explicit stack of directories, each removed
+    once it is empty."""
+    stack = [root]
+    while stack:
+        entries = list(os.scandir(stack[-1]))
+        below = [entry.path for entry in entries if entry.is_dir(follow_symlinks=False)]
+        if below:
+            stack.extend(below)
+            continue
+        for entry in entries:
+            os.unlink(entry.path)
+        os.rmdir(stack.pop())
 
 
 def _deep_path(root, leaf):
@@ -60,6 +80,7 @@ def test_make_directories_is_makedirs_without_recursion(tmp_path):
     storage.make_directories(deep)
     assert os.path.isdir(deep)
     storage.make_directories(deep)  # exist_ok
+    remove_tree(str(tmp_path / "d"))
     blocker = tmp_path / "file"
     blocker.write_text("")
     with pytest.raises(FileExistsError):
@@ -73,3 +94,4 @@ def test_a_path_longer_than_the_system_takes_is_one_line(tmp_path, capsys):
     err = capsys.readouterr().err
     assert err.startswith("loopsim: error:") and len(err.splitlines()) == 1
     assert "File name too long" in err
+    assert os.listdir(tmp_path) == []  # the levels it could make are removed again

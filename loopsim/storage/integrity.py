@@ -49,7 +49,8 @@ def remove_stale_temporaries(directory):
 def make_directories(path):
     """``os.makedirs(path, exist_ok=True)`` without its recursion (one call per level: a
     legal path 1 000 directories deep exhausted Python's stack): the missing directories
-    are made from the outermost in, each with the umask's mode.  FileExistsError where a
+    are made from the outermost in, each with the umask's mode, and removed again if a
+    deeper one cannot be made (ENAMETOOLONG past PATH_MAX).  FileExistsError where a
     component is a file."""
     path = os.path.abspath(os.fspath(path))
     missing = []
@@ -59,12 +60,22 @@ def make_directories(path):
         if parent == path:
             break
         path = parent
-    for directory in reversed(missing):
-        try:
-            os.mkdir(directory)
-        except FileExistsError:
-            if not os.path.isdir(directory):
-                raise
+    made = []
+    try:
+        for directory in reversed(missing):
+            try:
+                os.mkdir(directory)
+                made.append(directory)
+            except FileExistsError:
+                if not os.path.isdir(directory):
+                    raise
+    except OSError:
+        for directory in reversed(made):  # nothing half-made is left behind
+            try:
+                os.rmdir(directory)
+            except OSError:
+                break
+        raise
 
 
 def _umask():
