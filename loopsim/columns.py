@@ -134,7 +134,8 @@ SUMMARY_COLUMNS = {
         "perturbation", "method")},
     "seeds": (COUNT, "rows (seeds) in the cell"),
     "resolved": (COUNT, "rows of the cell whose n_used resolves them"),
-    "determined": (COUNT, "rows of the cell whose outcome is determined (a twin agreed)"),
+    "determined": (COUNT, "rows of the cell whose outcome is determined (a twin agreed; empty, "
+                          "unknown, where no row of the cell ran a twin: --no-twin)"),
     "steady": (COUNT, "rows of the cell that reached a steady state before t_end (stop_reason "
                       "steady); the others ran to t_end, their terminal values the state there, or "
                       "failed (empty, unknown, for a sweep run with --no-early-stop: no run was "
@@ -365,6 +366,29 @@ REST_STUDY_COLUMNS = {
                       "intervals), at rest against t = 10; empty where no t = 10 sample"),
 }
 
+#: ``data/paper_range_overview.parquet`` (``scripts/range_overview.py``): the paper's 225
+#: cells, each from the one committed study that answers it best (a run-to-rest sweep first,
+#: else a t = 10 table).
+RANGE_OVERVIEW_COLUMNS = {
+    **{name: REST_STUDY_COLUMNS[name] for name in ("g0", "theta0_deg", "q0")},
+    "source": (TEXT, "the committed table or sweep the cell's row comes from (data/...); empty "
+                     "where the cell was never run"),
+    "t_max": (TIME, "the horizon its runs had (10: the paper's; 40: run to rest); NaN if not run"),
+    "seeds": (COUNT, "rows (seeds) of the cell in its source (0: not run)"),
+    **{name: SUMMARY_COLUMNS[name] for name in (
+        "p_stable", "p_stable_low", "p_stable_high", "p_in_plane", "p_in_plane_low",
+        "p_in_plane_high", "p_3d", "p_3d_low", "p_3d_high", "p_failed")},
+    **{f"p_not_rest_t10{end}": (PROBABILITY, what) for end, what in (
+        ("", "P(not at rest by t = 10 t_u): the share of loops still moving (or failed) at the "
+             "paper's horizon; 1 - p_rest_t10, or 1 - steady / seeds for a t = 10 source"),
+        ("_low", "lower end of its 95% interval (Wilson, or the Kaplan-Meier log-log band)"),
+        ("_high", "upper end of its 95% interval"))},
+    "at_rest": (COUNT, "rows that passed the steady test before t_max"),
+    **{name: SUMMARY_COLUMNS[name] for name in (
+        "t_rest_median", "t_rest_q95", "rest_inside", "rest_below", "rest_outside",
+        "tilt_median", "tilt_median_low", "tilt_median_high")},
+}
+
 
 def field_metadata(name, table=RESULT_COLUMNS):
     """Parquet field metadata of a column: {b"unit": ..., b"description": ...}."""
@@ -385,7 +409,8 @@ def markdown(table=RESULT_COLUMNS):
 #: The tables ``python -m loopsim.columns [NAME]`` prints.
 TABLES = {"results": RESULT_COLUMNS, "trajectory": TRAJECTORY_COLUMNS,
           "summary": SUMMARY_COLUMNS, "compare": COMPARE_COLUMNS, "stops": STOP_COLUMNS,
-          "convergence": CONVERGENCE_COLUMNS, "rest": REST_STUDY_COLUMNS}
+          "convergence": CONVERGENCE_COLUMNS, "rest": REST_STUDY_COLUMNS,
+          "range": RANGE_OVERVIEW_COLUMNS}
 
 def main(argv=None):
     """``python -m loopsim.columns [NAME]``: print a column table as Markdown."""

@@ -8,9 +8,9 @@ two rows with one seed in one cell differ in an input the table does not record 
 ``initial`` shape, say), and are refused rather than merged.  Per cell:
 
 * ``seeds``, ``resolved``, ``determined``, ``steady``: how many rows, and how many of
-  them are resolved and determined (``loopsim.outcomes``) and reached a steady state
-  before ``t_end`` (unknown, ``<NA>``, where a row ran without the early stop:
-  ``rows_tested``);
+  them are resolved and determined (``loopsim.outcomes``; ``determined`` unknown,
+  ``<NA>``, where no row of the cell ran a twin) and reached a steady state before
+  ``t_end`` (unknown, ``<NA>``, where a row ran without the early stop: ``rows_tested``);
 * ``p_<regime>`` for each regime, with its 95 % Wilson score interval (no continuity
   correction; ``scipy.stats.binomtest(k, N).proportion_ci(method="wilson")``)
   ``p_<regime>_low``, ``p_<regime>_high``:
@@ -100,8 +100,9 @@ def rows_tested(rows, tested=True):
 
 def _cell_row(rows, seed, tested=True, motion=True, window=None):
     trials = len(rows)
+    twinned = rows["determined"].notna().any()  # unknown (<NA>) where no row had a twin
     out = dict(seeds=trials, resolved=int(rows["resolved"].sum()),
-               determined=int(rows["determined"].eq(True).sum()))
+               determined=int(rows["determined"].eq(True).sum()) if twinned else pd.NA)
     if "stop_reason" in rows:  # unknown (<NA>) where a row was never tested
         out["steady"] = (int(rows["stop_reason"].eq("steady").sum())
                          if rows_tested(rows, tested) else pd.NA)
@@ -219,6 +220,8 @@ def summarize(frame, by=None, seed=0, rest_window=None):
     table = pd.DataFrame(rows)
     if motion and table["unsteady"].isna().any():
         table["unsteady"] = table["unsteady"].astype("Int64")  # unknown: <NA>
+    if table["determined"].isna().any():
+        table["determined"] = table["determined"].astype("Int64")  # no twin ran: <NA>
     if "steady" in table and table["steady"].isna().any():
         table["steady"] = table["steady"].astype("Int64")  # unknown: <NA>, empty in Parquet
     table.attrs["loopsim_summary"] = dict(cells_by=by, bootstrap_seed=seed,
@@ -253,7 +256,8 @@ def outcome_counts(frame):
     their n), ``undetermined`` (rows whose twin ends elsewhere) and ``unsteady`` (rows
     still moving at their end, ``terminal_state``), each with the regimes among them
     (``unresolved_regimes``, ``undetermined_regimes``, ``unsteady_regimes``); ``failed``
-    (rows whose ``status`` is not "ok").
+    (rows whose ``status`` is not "ok"); ``twinned`` (rows that ran a twin: the only ones
+    whose ``determined`` is known).
 
     ``unsteady`` is None (unknown, never 0) where some row does not record
     ``terminal_state`` (written by an older release): ``unsteady_not_recorded`` says how
@@ -269,7 +273,20 @@ def outcome_counts(frame):
                 undetermined_regimes=_regime_counts(undetermined),
                 unsteady=None if missing else len(unsteady), unsteady_recorded=len(unsteady),
                 unsteady_not_recorded=missing, unsteady_regimes=_regime_counts(unsteady),
-                failed=int((frame["status"] != "ok").sum()))
+                failed=int((frame["status"] != "ok").sum()),
+                twinned=int(frame["determined"].notna().sum()))
+
+
+def undetermined_text(counts):
+    """The count of rows whose twin ends elsewhere as a reader should see it (from
+    :func:`outcome_counts`): "1 (regimes among them: 3d 1)", "not checked ..." where no row
+    ran a twin (``--no-twin``), with how many did where only some did."""
+    regimes = ", ".join(f"{k} {v}" for k, v in counts["undetermined_regimes"].items()) or "none"
+    twinned, cases = counts["twinned"], counts["cases"]
+    if twinned == 0:
+        return "not checked (unknown): no case ran a twin (--no-twin)"
+    text = f"{counts['undetermined']} (regimes among them: {regimes})"
+    return text if twinned == cases else f"{text}, of the {twinned} of {cases} cases with a twin"
 
 
 def unsteady_text(counts):

@@ -101,8 +101,8 @@ def _counts(counts, stopped):
              ("not resolved at their n", f"{counts['unresolved']} (regimes among them: "
               f"{_counts_text(counts['unresolved_regimes'])})"),
              ("resolved", counts["cases"] - counts["unresolved"]),
-             ("not determined (a twin ends elsewhere)", f"{counts['undetermined']} (regimes "
-              f"among them: {_counts_text(counts['undetermined_regimes'])})"),
+             ("not determined (a twin ends elsewhere)",
+              outcome_statistics.undetermined_text(counts)),
              ("still moving at their end (terminal_state unsteady)",
               outcome_statistics.unsteady_text(counts)),
              ("failed", counts["failed"])]

@@ -39,6 +39,7 @@ TABLES = {
     "phase_n6_cases.parquet": columns.RESULT_COLUMNS,
     "rest_study.parquet": columns.REST_STUDY_COLUMNS,
     "paper_range_rest_summary.parquet": columns.SUMMARY_COLUMNS,
+    "paper_range_overview.parquet": columns.RANGE_OVERVIEW_COLUMNS,
 }
 #: Columns that hold integer orders (written as floats before 0.3.0).
 INTEGER_COLUMNS = ("n",)

@@ -66,7 +66,8 @@ paper_range_top redraws the top of that range from the sweeps committed under
 data/paper_range_runs (``paper_range_study.py --top --read-only``: the parts themselves
 take hours each and run apart, see docs/studies/paper-range.md); rest_survival and
 rest_tilts redraw the run-to-rest study from data/rest_runs (``rest_study.py
---read-only``, docs/studies/rest.md).  Fig. 3 and
+--read-only``, docs/studies/rest.md); paper_range_overview draws the whole range from the
+committed tables (``range_overview.py``).  Fig. 3 and
 nonlocal_thresholds (the circle's critical q against ε) need no run.  Nothing
 here is random beyond the seeded initial perturbations
 (seed 0 unless stated), so a rerun reproduces the tables.
@@ -259,6 +260,7 @@ def targets(quick=False):
         "paper_range_top": ([], ("study_top",)),
         "rest_survival": ([], ("rest_study",)),
         "rest_tilts": ([], ("rest_study",)),
+        "paper_range_overview": ([], ("range_overview",)),
         "seed_distributions": (["seeds_n6", "seeds_auto"],
                                ("figures", "seeds_n6", ["seeds_n6", "seeds_auto"], "seeds",
                                 "seed_distributions")),
@@ -359,6 +361,18 @@ def draw(name, how, paths, out, work, quick):
         table = os.path.join(work, "rest_study.parquet") if quick else \
             os.path.join("data", "rest_study.parquet")
         command = [sys.executable, script, "--read-only", "--out", table, "--figures", out,
+                   *(["--window-n", "8", "--range-out",
+                      os.path.join(work, "paper_range_rest_summary.parquet")] if quick else [])]
+        print("$ " + " ".join(shlex.quote(a) for a in command), flush=True)
+        os.makedirs(work, exist_ok=True)
+        os.makedirs(out, exist_ok=True)
+        subprocess.run(command, check=True)
+    elif kind == "range_overview":  # the whole range from the committed tables: no run
+        script = os.path.join(os.path.dirname(__file__), "range_overview.py")
+        table = os.path.join(work, "paper_range_overview.parquet") if quick else \
+            os.path.join("data", "paper_range_overview.parquet")
+        command = [sys.executable, script, "--out", table,
+                   "--figure", os.path.join(out, "paper_range_overview.png"),
                    *(["--window-n", "8"] if quick else [])]
         print("$ " + " ".join(shlex.quote(a) for a in command), flush=True)
         os.makedirs(work, exist_ok=True)

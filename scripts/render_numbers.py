@@ -22,6 +22,8 @@ The tables:
 * ``data/convergence_top.parquet`` and ``data/convergence_runs``: the convergence study at
   the top of the range.
 * ``data/rest_study.parquet``: the run-to-rest study (``scripts/rest_study.py``).
+* ``data/paper_range_overview.parquet``: the paper's 225 cells, each from its best
+  committed study (``scripts/range_overview.py``).
 * ``data/rest_window.json``: where loops can rest, ``loopsim rest-window --g0 10:350:15
   --json`` (tests/test_rest_window.py checks it against the code).
 """
@@ -347,9 +349,51 @@ def _rest_study():
     return out
 
 
+def _range_overview():
+    """The paper's 225 cells, each from its best committed study
+    (``data/paper_range_overview.parquet``, ``scripts/range_overview.py``): ``range.*``
+    counts, and ``range.top-table``, the cells of g0 >= 252.9 as a grid."""
+    path = os.path.join(DATA, "paper_range_overview.parquet")
+    if not os.path.exists(path):
+        return {}
+    frame = pd.read_parquet(path)
+    known = frame[frame["seeds"] > 0]
+    rest = known[known["t_max"] > 10]
+    top = frame[frame["g0"] > 250]
+    g0s = sorted(top["g0"].unique())
+    rows = ["| θ0 | " + " | ".join(f"g0 = {g:.1f}" for g in g0s) + " |",
+            "|---|" + "---|" * len(g0s)]
+    for theta0, cells in top.groupby("theta0_deg"):
+        entries = []
+        for _, r in cells.sort_values("g0").iterrows():
+            if r["seeds"] == 0:
+                entries.append("not run")
+                continue
+            where = "to rest" if r["t_max"] > 10 else "t = 10"
+            entries.append(f"{r['p_3d']:.2f} / {r['p_not_rest_t10']:.2f} "
+                           f"({int(r['seeds'])}, {where})")
+        rows.append(f"| {theta0:.0f}° | " + " | ".join(entries) + " |")
+    moving = known[known["p_not_rest_t10"] > 0]
+    with open(os.path.join(DATA, "rest_window.json"), encoding="utf-8") as handle:
+        q_loss = json.load(handle)["q_loss"]   # the stable branch's upper edge
+    above = known[known["q0"] > q_loss]
+    return {"range.known": count(len(known)), "range.cells": count(len(frame)),
+            "range.rest-cells": count(len(rest)),
+            "range.horizon-cells": count(len(known) - len(rest)),
+            "range.not-run": count(len(frame) - len(known)),
+            "range.not-run-top": count(int((top["seeds"] == 0).sum())),
+            "range.moving-cells": count(len(moving)),
+            "range.rest-outside": count(rest["rest_outside"].sum()),
+            "range.rest-loops": count(rest["at_rest"].sum()),
+            "range.above-edge-cells": count(len(above)),
+            "range.above-edge-moving": (f"{above['p_not_rest_t10'].min():.2f}–"
+                                        f"{above['p_not_rest_t10'].max():.2f}"),
+            "range.top-table": "\n\n" + "\n".join(rows) + "\n\n"}
+
+
 #: Groups of keys, each computed together from one table; a key's function is its group's.
 GROUPS = (_n6_counts, _n6_labels, _grid_costs, _top_costs, _tumbling_samples, _convergence,
-          _rest_window, _rest_study)
+          _rest_window, _rest_study, _range_overview)
 
 
 @functools.lru_cache(maxsize=None)

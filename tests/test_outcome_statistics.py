@@ -141,7 +141,9 @@ def test_summary_command_on_a_sweep_with_seeds(tmp_path, capsys):
     table = pd.read_parquet(path)
     assert list(table["g0"]) == [10.0, 40.0] and list(table["seeds"]) == [3, 3]
     again = loopsim.summarize(loopsim.read_results(str(out)))
-    pd.testing.assert_frame_equal(table, again)
+    assert again["determined"].isna().all()   # --no-twin: unknown, and empty in Parquet
+    # (a count with unknowns, Int64 here, reads back from Parquet as float with NaN)
+    pd.testing.assert_frame_equal(table, again.astype({"determined": "float64"}))
     schema = pq.read_schema(path)
     for field in schema:  # every column declared in loopsim.columns, with its unit
         assert field.metadata[b"unit"] == columns.SUMMARY_COLUMNS[field.name][0].encode()
@@ -343,3 +345,36 @@ def test_steady_is_unknown_for_rows_never_tested_however_the_table_was_read(tmp_
     assert main(["summary", untested]) == 0
     assert pd.isna(outcome_statistics.summarize(b)["steady"].iloc[0])
     assert a["early_stop"].tolist() == [True, True] and b["early_stop"].tolist() == [False] * 2
+
+
+def test_determined_is_unknown_where_no_row_ran_a_twin(tmp_path, capsys):
+    """Audit L6: a --no-twin sweep's cells read "determined 0" (every seed undetermined,
+    ringed red in the phase diagram) although no twin ran; unknown is <NA>, and a cell
+    whose rows did run twins still counts them."""
+    grid = ["--theta0", "30", "--seeds", "2", "--n", "4", "--t-end", "0.3", "--threads", "1",
+            "--quiet"]
+    alone, twinned = str(tmp_path / "alone"), str(tmp_path / "twinned")
+    assert main(["sweep", "--g0", "10", *grid, "--no-twin", "--out", alone]) == 0
+    assert main(["sweep", "--g0", "40", *grid, "--out", twinned]) == 0
+    capsys.readouterr()
+    a, b = loopsim.read_results(alone), loopsim.read_results(twinned)
+    both = outcome_statistics.summarize(pd.concat([a, b], ignore_index=True))
+    assert pd.isna(both["determined"].iloc[0]) and str(both["determined"].dtype) == "Int64"
+    assert both["determined"].iloc[1] == int(b["determined"].eq(True).sum()) == 2
+    assert outcome_statistics.summarize(b)["determined"].dtype == np.int64  # all known
+    counts = outcome_statistics.outcome_counts(a)
+    assert counts["twinned"] == 0 and outcome_statistics.undetermined_text(counts).startswith(
+        "not checked (unknown)")
+    mixed = outcome_statistics.outcome_counts(pd.concat([a, b], ignore_index=True))
+    assert outcome_statistics.undetermined_text(mixed).endswith(
+        "of the 2 of 4 cases with a twin")
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from loopsim import figures
+
+    labels = figures.probability_phase_diagram(both).axes[0].get_legend_handles_labels()[1]
+    assert "some seeds not determined" not in labels    # (both cells: none known undetermined)
+    undetermined = both.assign(determined=pd.array([pd.NA, 1], dtype="Int64"))
+    labels = figures.probability_phase_diagram(undetermined).axes[0].get_legend_handles_labels()[1]
+    assert "some seeds not determined" in labels

@@ -295,3 +295,13 @@ def test_report_of_rows_without_terminal_state_says_not_recorded(tmp_path):
     frame = loopsim.read_results(os.path.join(root, "data", "convergence_runs", "default_t12"))
     counts = outcome_statistics.outcome_counts(frame)
     assert counts["unsteady"] is None and counts["unsteady_not_recorded"] == 80
+
+
+def test_report_of_a_sweep_without_twins_says_not_checked(tmp_path):
+    """Audit L6: the report of a --no-twin sweep read "not determined: 0"."""
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    out = tmp_path / "r.html"
+    assert main(["report", os.path.join(root, "data", "rest_runs", "range_rest_t36"),
+                 "--out", str(out)]) == 0
+    undetermined = _counts_cell(out.read_text(encoding="utf-8"), "not determined")
+    assert undetermined.startswith("not checked (unknown): no case ran a twin"), undetermined

@@ -10,9 +10,10 @@ def add_parser(commands):
         "summary", help="one row per cell of a sweep: regime probabilities, tilt and aspect "
         "ratio medians, with 95%% intervals",
         description="Summarise a sweep over its seeds: per cell (g0, theta0 and every other "
-        "swept input), the number of seeds, resolved, determined and steady rows (steady: "
-        "a terminal state reached before --t-end; empty, unknown, for a sweep run with "
-        "--no-early-stop), each regime's "
+        "swept input), the number of seeds, resolved, determined and steady rows "
+        "(determined: empty, unknown, for a sweep run with --no-twin; steady: a terminal "
+        "state reached before --t-end, empty for a sweep run with --no-early-stop), each "
+        "regime's "
         "probability with its Wilson interval, the median and quartiles of the terminal "
         "tilt and aspect ratio with bootstrap intervals of the medians, how long the loops "
         "took to come to rest (P(at rest by t = 10), the median settling time, the escape "

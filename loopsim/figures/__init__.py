@@ -29,6 +29,7 @@ as DataFrames, so every function can be drawn from stored numbers:
   linearisation of the circle, the nonlocal model beside the local one;
 * :func:`survival_curves`, :func:`rest_tilts` - how long loops take to come to rest
   (Kaplan–Meier) and where they rest against the stable branch's tilt window;
+  :func:`range_overview` - the paper's range cell by cell, with P(not at rest by t = 10);
 * :func:`trajectory` - one run's snapshots, face-on, with tilt and aspect ratio;
 * :func:`save` - write a figure atomically;
 * :func:`animate` - a GIF or MP4 of one run (``loopsim animate``, module ``animation``);
@@ -57,7 +58,7 @@ from .gallery import gallery, plane_view, side_view_basis, unit_circle
 from .linear import branch_lines, growth_rates, load_branch, stability, stability_data
 from .nonlocal_sbt import model_outcomes, nonlocal_thresholds
 from .phase import phase_diagram, phase_diagrams
-from .settling import rest_tilts, survival_curves
+from .settling import range_overview, rest_tilts, survival_curves
 from .style import (
     ASPECT_LABEL, CURVE_POINTS, PAPER_BAND, REGIME_STYLE, TIME_CMAP, centred_curve, coefficients,
     default_thresholds, frame_model, mark_undetermined, merged_legend_entries, model_text,
@@ -79,7 +80,8 @@ __all__ = [
     "mark_undetermined", "merged_legend_entries", "model_outcomes", "model_text", "new_figure",
     "nonlocal_thresholds", "order_column", "orders_text", "phase_diagram", "phase_diagrams",
     "plane_view", "probability_phase_diagram", "q_and_tilt", "q_lines", "read_run", "read_sweep",
-    "regime_key", "regime_pies", "regime_style", "resolved_mask", "rest_tilts", "rest_window_curve",
+    "range_overview", "regime_key", "regime_pies", "regime_style", "resolved_mask", "rest_tilts",
+    "rest_window_curve",
     "rest_window_for", "run_title", "save",
     "save_distribution_figure", "survival_curves",
     "scatter_regimes", "seed_distributions", "settling_index", "side_view_basis", "single_axes",

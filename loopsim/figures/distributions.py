@@ -91,7 +91,8 @@ def probability_phase_diagram(cells, frame=None, ax=None, style="pie", rest_wind
         for _, cell in cells[(cells["p_in_plane"] > 0) & (cells["p_in_plane"] < 1)].iterrows():
             ax.annotate(f"{cell['p_in_plane']:.2f}", (cell["theta0_deg"], cell["g0"]),
                         textcoords="offset points", xytext=(0, 7), ha="center", fontsize=6)
-    mixed = cells[cells["determined"] < cells["seeds"]]
+    mixed = cells[(cells["determined"] < cells["seeds"]).fillna(False).astype(bool)]
+    # (a cell whose determined is unknown, <NA>: no twin ran, is not ringed)
     if len(mixed):
         ax.scatter(mixed["theta0_deg"], mixed["g0"], s=230 if style == "pie" else 150,
                    facecolors="none", edgecolors="#d62728", linewidths=0.9, zorder=4,
@@ -110,6 +111,21 @@ def probability_phase_diagram(cells, frame=None, ax=None, style="pie", rest_wind
                     ax.annotate(f"{1.0 - cell['p_rest_t10']:.2f}",
                                 (cell["theta0_deg"] + 3.2, cell["g0"] + 0.035 * cells["g0"].max()),
                                 fontsize=5, va="center", zorder=5)
+    threshold_curves(ax, rest_window)
+    ax.set_ylim(0, 1.08 * cells["g0"].max())
+    seeds = sorted(set(int(k) for k in cells["seeds"]))
+    count = str(seeds[0]) if len(seeds) == 1 else f"{seeds[0]}-{seeds[-1]}"
+    ax.set_title(f"regime probabilities per cell over {count} seeds" if style == "pie" else
+                 f"P(3D) per cell over {count} seeds (numbers: P(in-plane))", fontsize=10)
+    ax.legend(fontsize=7, frameon=False, loc="upper center", bbox_to_anchor=(0.5, -0.14),
+              ncol=3)
+    return fig
+
+
+def threshold_curves(ax, rest_window=None):
+    """The full linearisation's thresholds (n = 16) as curves g0 = 3 q_c / sin θ0 over the
+    (θ0, g0) plane, with ``rest_window``'s upper edge where given; the axes' θ0 range
+    and labels."""
     theta = np.linspace(1.0, 90.0, 300)
     for sector, line in (("in-plane", "--"), ("out-of-plane", ":")):
         q_sector = full_linear.critical_q(16, sector)
@@ -118,16 +134,8 @@ def probability_phase_diagram(cells, frame=None, ax=None, style="pie", rest_wind
     if rest_window is not None:
         rest_window_curve(ax, rest_window, theta)
     ax.set_xlim(0, 92)
-    ax.set_ylim(0, 1.08 * cells["g0"].max())
     ax.set_xlabel(r"initial tilt $\theta_0$ (deg)")
     ax.set_ylabel(r"$g_0$ (gravity / stiffness)")
-    seeds = sorted(set(int(k) for k in cells["seeds"]))
-    count = str(seeds[0]) if len(seeds) == 1 else f"{seeds[0]}-{seeds[-1]}"
-    ax.set_title(f"regime probabilities per cell over {count} seeds" if style == "pie" else
-                 f"P(3D) per cell over {count} seeds (numbers: P(in-plane))", fontsize=10)
-    ax.legend(fontsize=7, frameon=False, loc="upper center", bbox_to_anchor=(0.5, -0.14),
-              ncol=3)
-    return fig
 
 
 def tilt_distribution(cells, frame=None, ax=None):

@@ -1,10 +1,13 @@
 """How long loops take to come to rest, and where they rest: the Kaplan–Meier survival of
-"not yet at rest" per cell (``loopsim.survival``), and terminal tilts against the stable
-branch's tilt window (``loopsim.stability.rest_window``)."""
+"not yet at rest" per cell (``loopsim.survival``), terminal tilts against the stable
+branch's tilt window (``loopsim.stability.rest_window``), and the paper's range as
+regime probabilities and P(not at rest by t = 10) cell by cell."""
+import matplotlib.pyplot as plt
 import numpy as np
 
 from .. import survival
-from .style import single_axes
+from .distributions import regime_pies, threshold_curves
+from .style import merged_legend_entries, single_axes
 
 #: Line colours of successive cells (matplotlib's tab10 order).
 CELL_COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple", "tab:brown",
@@ -85,4 +88,48 @@ def rest_tilts(frame, window, ax=None):
     ax.legend(fontsize=7, frameon=False, loc="upper left")
     ax.set_title(f"where loops rest: the stable branch's tilt window\n(q = g0 sin θ / 3 from "
                  f"{window.q_circle:.4f} to the first loss, {window.q_loss:.4f})", fontsize=9)
+    return fig
+
+
+def range_overview(cells, window=None):
+    """The paper's (θ0, g0) grid cell by cell, from one row per cell (columns ``g0``,
+    ``theta0_deg``, ``seeds``, ``t_max``, ``p_stable``, ``p_in_plane``, ``p_3d``,
+    ``p_failed``, ``p_not_rest_t10``; ``scripts/range_overview.py`` writes such a table):
+    left, the regime probabilities as pies; right, P(not at rest by t = 10), the share of
+    loops still moving at the paper's horizon (numbers where above 0).  Cells run past
+    t = 10 are ringed, cells not run crossed; both panels carry the thresholds and,
+    with ``window`` (``loopsim.stability.rest_window.RestWindow``), the stable branch's
+    upper edge: cells above it start above the tilts where a loop can rest.  Returns the
+    figure."""
+    fig, (pies, late) = plt.subplots(1, 2, figsize=(13.0, 5.6), sharey=True)
+    known = cells[cells["seeds"] > 0]
+    regime_pies(known, pies, size=110)
+    moving = known["p_not_rest_t10"].to_numpy(float)
+    points = late.scatter(known["theta0_deg"], known["g0"], c=moving, cmap="YlOrRd", vmin=0.0,
+                          vmax=1.0, s=80, edgecolors="0.4", linewidths=0.4, zorder=3)
+    fig.colorbar(points, ax=late, label="P(not at rest by t = 10) over seeds", pad=0.01)
+    for (_, cell), share in zip(known.iterrows(), moving):
+        if share > 0:
+            late.annotate(f"{share:.2f}".lstrip("0"), (cell["theta0_deg"], cell["g0"]),
+                          ha="center", va="center", fontsize=4.5, zorder=4,
+                          color="white" if share > 0.6 else "black")
+    longer, empty = known[known["t_max"] > survival.PAPER_HORIZON], cells[cells["seeds"] == 0]
+    for ax in (pies, late):
+        if len(longer):
+            ax.scatter(longer["theta0_deg"], longer["g0"], s=170, facecolors="none",
+                       edgecolors="k", linewidths=0.7, zorder=4,
+                       label=f"run to rest (t_max = {longer['t_max'].max():g})")
+        if len(empty):
+            ax.scatter(empty["theta0_deg"], empty["g0"], marker="x", s=25, color="0.55",
+                       zorder=3, label="not run yet")
+        threshold_curves(ax, window)
+        ax.set_ylim(0, 1.06 * cells["g0"].max())
+    late.set_ylabel("")
+    seeds = known["seeds"]
+    pies.set_title(f"regime probabilities per cell ({int(seeds.min())}-{int(seeds.max())} "
+                   "seeds)", fontsize=10)
+    late.set_title("what the paper's horizon hides: loops not at rest by t = 10", fontsize=10)
+    handles, labels = merged_legend_entries([pies, late])
+    fig.legend(handles, labels, fontsize=7, frameon=False, loc="lower center", ncol=4)
+    fig.subplots_adjust(left=0.06, right=0.97, top=0.94, bottom=0.2, wspace=0.06)
     return fig

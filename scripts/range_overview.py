@@ -1,0 +1,192 @@
+"""The paper's range in one table and one figure: every cell of its grid, from the committed
+study that answers it best (issue 53, item 4).
+
+Usage: python scripts/range_overview.py [--data data] [--out data/paper_range_overview.parquet]
+                                        [--figure docs/figures/paper_range_overview.png]
+                                        [--window-n 16]
+
+Runs nothing: it reads the committed tables and sweeps under ``--data``.
+
+* Run to rest (``t_max`` 40): the sweeps under ``DATA/rest_runs`` (``scripts/rest_study.py``:
+  the four 16-seed cells of the study, and the ``range_rest_t<θ0>`` sweeps, 8 seeds per
+  cell), each cell once all its seeds have finished (a sweep still running gives the
+  cells it has finished), summarised by ``loopsim.summarize`` with the stable branch's
+  window.  A cell in several sweeps takes the one with the most seeds.
+* At the paper's horizon (``t_max`` 10): ``DATA/paper_range_top_summary.parquet`` and
+  ``DATA/paper_range_summary.parquet`` (``scripts/paper_range_study.py``, ``--seeds auto``
+  with twins), for the cells not run to rest.  Their P(not at rest by t = 10) is
+  1 - steady / seeds (the steady test is what "at rest" means), with its Wilson interval.
+* A cell in none of them is a row with ``seeds`` 0 and an empty ``source``.
+
+Writes ``--out`` (columns: ``loopsim.columns.RANGE_OVERVIEW_COLUMNS``, each described;
+225 rows, one per cell) and ``--figure`` (``loopsim.figures.range_overview``: the regime
+probabilities and P(not at rest by t = 10) per cell, the thresholds and the stable
+branch's upper edge).  It refuses (exit status 2, nothing written) where the table at
+``--out`` knows a cell that this run would not.
+"""
+import argparse
+import glob
+import json
+import os
+import sys
+
+import numpy as np
+import pandas as pd
+import pyarrow as pa
+
+import loopsim
+from loopsim import columns, outcome_statistics, storage
+from loopsim.intervals import wilson_interval
+from loopsim.stability import rest_window
+
+#: The paper's grid: g0 = 10..350 in 15 values, θ0 = 6..90° in 15.
+G0 = np.linspace(10.0, 350.0, 15)
+THETA0 = np.linspace(6.0, 90.0, 15)
+#: The t = 10 tables, the first that holds a cell answering it.
+HORIZON_TABLES = ("paper_range_top_summary.parquet", "paper_range_summary.parquet")
+PAPER_HORIZON = 10.0
+CELL = ("g0", "theta0_deg")
+
+
+def cell_key(g0, theta0):
+    """A cell's key, robust to the last bits of g0 (np.linspace against its repr)."""
+    return round(float(g0), 6), round(float(theta0), 6)
+
+
+def finished_cells(path):
+    """{cell key: rows} of the cells of the sweep at ``path`` whose every case has finished
+    (the sweep's case list, ``sweep_config``, says how many each has)."""
+    frame = loopsim.read_results(path)
+    cases = pd.DataFrame(frame.attrs["loopsim"]["sweep_config"]["cases"])
+    wanted = cases.groupby(list(CELL)).size()
+    out = {}
+    for (g0, theta0), rows in frame.groupby(list(CELL)):
+        if len(rows) == wanted.get((g0, theta0), -1):
+            out[cell_key(g0, theta0)] = rows
+    return out
+
+
+def rest_cells(data, window):
+    """{cell key: summary row} of the cells run to rest, the largest sample of each."""
+    best = {}
+    for path in sorted(glob.glob(os.path.join(data, "rest_runs", "*rest_t*"))):
+        if not os.path.isdir(path):
+            continue
+        for key, rows in finished_cells(path).items():
+            if key not in best or len(rows) > len(best[key][1]):
+                best[key] = (os.path.relpath(path, os.path.dirname(data)), rows)
+    out = {}
+    for key, (source, rows) in best.items():
+        row = outcome_statistics.summarize(rows, rest_window=window).iloc[0]
+        out[key] = overview_row(row, source, float(rows["t_end"].max()))
+    return out
+
+
+def horizon_cells(data):
+    """{cell key: summary row} of the cells of the t = 10 tables (the first table wins)."""
+    out = {}
+    for name in HORIZON_TABLES:
+        path = os.path.join(data, name)
+        if not os.path.exists(path):
+            continue
+        for _, row in pd.read_parquet(path).iterrows():
+            key = cell_key(row["g0"], row["theta0_deg"])
+            if key not in out:
+                out[key] = overview_row(row, os.path.join(os.path.basename(data), name),
+                                        PAPER_HORIZON)
+    return out
+
+
+def overview_row(row, source, t_max):
+    """One cell's row of the overview from a ``loopsim.summarize`` row."""
+    out = {name: row.get(name, np.nan) for name in columns.RANGE_OVERVIEW_COLUMNS}
+    seeds = int(row["seeds"])
+    out.update(source=source, t_max=t_max, seeds=seeds,
+               q0=row["g0"] * np.sin(np.radians(row["theta0_deg"])) / 3)
+    if "p_rest_t10" in row and row["p_rest_t10"] == row["p_rest_t10"]:
+        out["p_not_rest_t10"] = 1.0 - row["p_rest_t10"]
+        out["p_not_rest_t10_low"] = 1.0 - row["p_rest_t10_high"]
+        out["p_not_rest_t10_high"] = 1.0 - row["p_rest_t10_low"]
+    else:   # a table of the paper's horizon without the settling statistics
+        moving = seeds - int(row["steady"])
+        out["p_not_rest_t10"] = moving / seeds
+        out["p_not_rest_t10_low"], out["p_not_rest_t10_high"] = wilson_interval(moving, seeds)
+    out["at_rest"] = row["at_rest"] if "at_rest" in row else row["steady"]
+    return out
+
+
+def overview(data, window):
+    """The 225-row table: each cell from the run-to-rest sweeps, else the t = 10 tables,
+    else empty."""
+    found = {**horizon_cells(data), **rest_cells(data, window)}   # run to rest wins
+    rows = []
+    for theta0 in THETA0:
+        for g0 in G0:
+            row = found.get(cell_key(g0, theta0))
+            if row is None:
+                row = {name: np.nan for name in columns.RANGE_OVERVIEW_COLUMNS}
+                row.update(g0=g0, theta0_deg=theta0, q0=g0 * np.sin(np.radians(theta0)) / 3,
+                           source="", seeds=0)
+            rows.append(row)
+    table = pd.DataFrame(rows, columns=list(columns.RANGE_OVERVIEW_COLUMNS))
+    for name in ("seeds", "at_rest", "rest_inside", "rest_below", "rest_outside"):
+        table[name] = table[name].astype("Int64")   # unknown: <NA>
+    return table
+
+
+def known_cells(path):
+    """The cells (``storage.study_keys``) with seeds of the overview table at ``path``;
+    none where there is no file.  ValueError (one line) where it cannot be read."""
+    if not os.path.isfile(path):
+        return set()
+    try:
+        held = pd.read_parquet(path, columns=[*CELL, "seeds"])
+    except Exception as exc:  # noqa: BLE001 - any unreadable table is kept as it is
+        raise ValueError(f"{path!r} cannot be read to compare its rows ({exc})") from None
+    return storage.study_keys(held[held["seeds"] > 0], CELL)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--data", default="data", help="the committed tables and sweeps")
+    parser.add_argument("--out", default=os.path.join("data", "paper_range_overview.parquet"))
+    parser.add_argument("--figure",
+                        default=os.path.join("docs", "figures", "paper_range_overview.png"))
+    parser.add_argument("--window-n", type=int, default=rest_window.DEFAULT_WINDOW_N,
+                        help="truncation order of the steady branch whose window is used")
+    args = parser.parse_args(argv)
+    window = rest_window.stability_losses(args.window_n)
+    table = overview(args.data, window)
+    known = table[table["seeds"] > 0]
+    try:
+        held = known_cells(args.out)
+    except ValueError as exc:
+        sys.exit(f"range_overview: error: {exc}: nothing written over it; give another --out")
+    lost = held - storage.study_keys(known, CELL)
+    if lost:
+        g0, theta0 = sorted(lost)[0]
+        print(f"range_overview: error: {args.out} knows {len(held)} cells, this run only "
+              f"{len(known)} (e.g. g0 = {g0:g}, theta0 = {theta0:g}); give another --out",
+              file=sys.stderr)
+        sys.exit(2)
+    meta = dict(sources=sorted(set(known["source"])), window=window.as_dict(),
+                intervals="95% Wilson or Kaplan-Meier log-log", loopsim_version=loopsim.__version__)
+    arrow = pa.Table.from_pandas(table, preserve_index=False)
+    arrow = arrow.replace_schema_metadata(storage.provenance(
+        loopsim_range_overview=json.dumps(meta)))
+    storage.write_table_atomically(storage.described(arrow, columns.RANGE_OVERVIEW_COLUMNS),
+                                   args.out)
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from loopsim import figures
+
+    figures.save(figures.range_overview(table, window), args.figure, dpi=150)
+    by_source = known.groupby("t_max").size()
+    print(f"wrote {args.out}: {len(known)} of {len(table)} cells known "
+          + ", ".join(f"{n} at t_max = {t:g}" for t, n in by_source.items())
+          + f"; figure {args.figure}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,100 @@
+"""scripts/range_overview.py: one row per cell of the paper's grid, each from the committed
+study that answers it best, checked against the sources it reads; its refusal to forget a
+cell."""
+import os
+import subprocess
+import sys
+
+import numpy as np
+import pandas as pd
+import pyarrow.parquet as pq
+import pytest
+
+import loopsim
+from loopsim import columns, outcome_statistics
+from loopsim.intervals import wilson_interval
+from loopsim.stability import rest_window
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+SCRIPT = os.path.join(ROOT, "scripts", "range_overview.py")
+DATA = os.path.join(ROOT, "data")
+WINDOW_N = 8
+
+
+def run(out, figure):
+    return subprocess.run([sys.executable, SCRIPT, "--data", DATA, "--out", str(out),
+                           "--figure", str(figure), "--window-n", str(WINDOW_N)],
+                          capture_output=True, text=True, cwd=ROOT)
+
+
+@pytest.fixture(scope="module")
+def overview(tmp_path_factory):
+    where = tmp_path_factory.mktemp("overview")
+    out, figure = where / "overview.parquet", where / "overview.png"
+    done = run(out, figure)
+    assert done.returncode == 0, done.stderr
+    return dict(table=pd.read_parquet(out), out=out, figure=figure)
+
+
+def cell(table, g0, theta0):
+    rows = table[np.isclose(table["g0"], g0) & np.isclose(table["theta0_deg"], theta0)]
+    assert len(rows) == 1
+    return rows.iloc[0]
+
+
+def test_every_cell_once_with_declared_columns(overview):
+    table = overview["table"]
+    assert len(table) == 225 and not table.duplicated(["g0", "theta0_deg"]).any()
+    assert list(table.columns) == list(columns.RANGE_OVERVIEW_COLUMNS)
+    fields = pq.read_schema(overview["out"])
+    assert all(fields.field(c).metadata[b"unit"] for c in table.columns)
+    assert overview["figure"].stat().st_size > 0
+    known = table[table["seeds"] > 0]
+    assert set(known["t_max"]) <= {10.0, 40.0}
+    assert ((known["p_not_rest_t10_low"] <= known["p_not_rest_t10"])
+            & (known["p_not_rest_t10"] <= known["p_not_rest_t10_high"])).all()
+
+
+def test_a_cell_at_the_papers_horizon_is_its_t10_table_row(overview):
+    source = pd.read_parquet(os.path.join(DATA, "paper_range_summary.parquet"))
+    mine = cell(overview["table"], 252.857142857, 6.0)   # q0 = 8.81: slow to decay
+    theirs = source[np.isclose(source["g0"], 252.857142857) & (source["theta0_deg"] == 6.0)]
+    theirs = theirs.iloc[0]
+    assert mine["source"] == "data/paper_range_summary.parquet" and mine["t_max"] == 10.0
+    assert mine["p_stable"] == theirs["p_stable"] and mine["seeds"] == theirs["seeds"]
+    moving = int(theirs["seeds"] - theirs["steady"])
+    assert mine["p_not_rest_t10"] == moving / theirs["seeds"]
+    assert (mine["p_not_rest_t10_low"], mine["p_not_rest_t10_high"]) == pytest.approx(
+        wilson_interval(moving, int(theirs["seeds"])))
+
+
+def test_a_cell_run_to_rest_is_its_largest_sample(overview):
+    """(350, 18°) is in the t = 10 table (8 seeds) and the run-to-rest study (16): the
+    latter answers it, recomputed here from its runs."""
+    rows = loopsim.read_results(os.path.join(DATA, "rest_runs", "rest_t18_350"))
+    mine = cell(overview["table"], 350.0, 18.0)
+    assert mine["source"] == "data/rest_runs/rest_t18_350" and mine["seeds"] == len(rows) == 16
+    stats = outcome_statistics.summarize(
+        rows, rest_window=rest_window.stability_losses(WINDOW_N)).iloc[0]
+    assert mine["t_max"] == 40.0 and mine["p_3d"] == stats["p_3d"]
+    assert mine["p_not_rest_t10"] == pytest.approx(1.0 - stats["p_rest_t10"])
+    assert mine["at_rest"] == int(rows["stop_reason"].eq("steady").sum())
+    assert mine["rest_inside"] + mine["rest_below"] + mine["rest_outside"] == mine["at_rest"]
+
+
+def test_a_cell_never_run_is_empty_not_zero(overview):
+    table = overview["table"]
+    empty = table[table["seeds"] == 0]
+    assert (empty["source"] == "").all() and empty["p_3d"].isna().all()
+    assert empty["p_not_rest_t10"].isna().all() and empty["at_rest"].isna().all()
+
+
+def test_refuses_to_forget_a_known_cell(overview, tmp_path):
+    table = overview["table"].copy()
+    gone = table.index[table["seeds"] == 0][0]
+    table.loc[gone, "seeds"] = 8       # a cell this run does not know
+    out = tmp_path / "overview.parquet"
+    table.to_parquet(out)
+    done = run(out, tmp_path / "figure.png")
+    assert done.returncode == 2 and "knows" in done.stderr and len(done.stderr.splitlines()) == 1
+    assert pd.read_parquet(out)["seeds"].loc[gone] == 8 and not (tmp_path / "figure.png").exists()
