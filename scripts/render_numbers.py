@@ -391,9 +391,23 @@ def _range_overview():
             "range.top-table": "\n\n" + "\n".join(rows) + "\n\n"}
 
 
+def _range_rest_cost():
+    """What a loop run to rest costs at the top of the range: the rows of every
+    ``data/rest_runs/range_rest_t*`` sweep so far (``wall_s``, 2 shared cores)."""
+    paths = sorted(glob.glob(os.path.join(DATA, "rest_runs", "range_rest_t*")))
+    if not paths:
+        return {}
+    walls = pd.concat([table(os.path.relpath(p, DATA))["wall_s"] for p in paths]).to_numpy(float)
+    return {"range.rest-runs": count(walls.size),
+            "range.rest-sample-median": f"{np.median(walls):.0f} s",
+            "range.rest-sample-span": f"{walls.min():.1f}–{walls.max():.0f} s",
+            "range.rest-cell-hours": f"{8 * walls.mean() / 3600:.2f} h",
+            "range.rest-cells60-hours": f"{60 * 8 * walls.mean() / 3600:.0f} h"}
+
+
 #: Groups of keys, each computed together from one table; a key's function is its group's.
 GROUPS = (_n6_counts, _n6_labels, _grid_costs, _top_costs, _tumbling_samples, _convergence,
-          _rest_window, _rest_study, _range_overview)
+          _rest_window, _rest_study, _range_overview, _range_rest_cost)
 
 
 @functools.lru_cache(maxsize=None)
