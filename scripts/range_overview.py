@@ -160,13 +160,13 @@ def main(argv=None):
     known = table[table["seeds"] > 0]
     try:
         held = known_cells(args.out)
+        lost = held - storage.study_keys(known, CELL)
+        if lost:
+            g0, theta0 = sorted(lost)[0]
+            raise ValueError(f"{args.out} knows {len(held)} cells, this run only {len(known)} "
+                             f"(e.g. g0 = {g0:g}, theta0 = {theta0:g})")
     except ValueError as exc:
-        sys.exit(f"range_overview: error: {exc}: nothing written over it; give another --out")
-    lost = held - storage.study_keys(known, CELL)
-    if lost:
-        g0, theta0 = sorted(lost)[0]
-        print(f"range_overview: error: {args.out} knows {len(held)} cells, this run only "
-              f"{len(known)} (e.g. g0 = {g0:g}, theta0 = {theta0:g}); give another --out",
+        print(f"range_overview: error: {exc}: nothing written over it; give another --out",
               file=sys.stderr)
         sys.exit(2)
     meta = dict(sources=sorted(set(known["source"])), window=window.as_dict(),

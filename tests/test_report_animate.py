@@ -21,6 +21,8 @@ PIL = pytest.importorskip("PIL")
 from PIL import Image, ImageSequence  # noqa: E402
 
 SNAPSHOTS = 12
+#: The committed tables and sweeps.
+DATA = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "data")
 
 
 @pytest.fixture(scope="module")
@@ -283,25 +285,25 @@ def _counts_cell(content, label):
     return html.unescape(found.group(1))
 
 
+def _committed_report_cell(tmp_path, sweep, label):
+    """The counts row ``label`` of the report of a committed sweep under data/."""
+    out = tmp_path / "r.html"
+    assert main(["report", os.path.join(DATA, sweep), "--out", str(out)]) == 0
+    return _counts_cell(out.read_text(encoding="utf-8"), label)
+
+
 def test_report_of_rows_without_terminal_state_says_not_recorded(tmp_path):
     """Issue 54.1: data/convergence_runs/default_t12 (80 rows, none with terminal_state:
     written before it existed) reported "still moving at their end: 0"."""
-    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    out = tmp_path / "r.html"
-    assert main(["report", os.path.join(root, "data", "convergence_runs", "default_t12"),
-                 "--out", str(out)]) == 0
-    moving = _counts_cell(out.read_text(encoding="utf-8"), "still moving at their end")
+    sweep = os.path.join("convergence_runs", "default_t12")
+    moving = _committed_report_cell(tmp_path, sweep, "still moving at their end")
     assert moving.startswith("not recorded (unknown) for 80 of 80 cases"), moving
-    frame = loopsim.read_results(os.path.join(root, "data", "convergence_runs", "default_t12"))
-    counts = outcome_statistics.outcome_counts(frame)
+    counts = outcome_statistics.outcome_counts(loopsim.read_results(os.path.join(DATA, sweep)))
     assert counts["unsteady"] is None and counts["unsteady_not_recorded"] == 80
 
 
 def test_report_of_a_sweep_without_twins_says_not_checked(tmp_path):
     """Audit L6: the report of a --no-twin sweep read "not determined: 0"."""
-    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    out = tmp_path / "r.html"
-    assert main(["report", os.path.join(root, "data", "rest_runs", "range_rest_t36"),
-                 "--out", str(out)]) == 0
-    undetermined = _counts_cell(out.read_text(encoding="utf-8"), "not determined")
+    undetermined = _committed_report_cell(tmp_path, os.path.join("rest_runs", "range_rest_t36"),
+                                          "not determined")
     assert undetermined.startswith("not checked (unknown): no case ran a twin"), undetermined
