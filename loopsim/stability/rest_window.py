@@ -18,8 +18,10 @@ only where
     q_c ≤ g0 sin θ / 3 ≤ q_loss      ⇔      arcsin(3 q_c / g0) ≤ θ ≤ arcsin(min(1, 3 q_loss / g0))
 
 and as a tilted circle at θ < arcsin(3 q_c / g0) (any tilt if 3 q_c ≥ g0).  Tilts in
-degrees, q and g0 dimensionless.  The local model only: the nonlocal model's branch is
-not continued (``loopsim.stability.branch`` uses the local right-hand side).
+degrees, q and g0 dimensionless.  The local model only: in nonlocal slender-body theory
+gravity normal to a non-circular loop's plane does not move its points alike, so a tilted
+steady shape bends out of its plane and the tilt no longer enters through q alone
+(docs/steady-branch.md).
 """
 from __future__ import annotations
 
