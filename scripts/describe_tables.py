@@ -37,6 +37,8 @@ TABLES = {
     "paper_range_stops.parquet": columns.STOP_COLUMNS,
     "convergence_top.parquet": columns.CONVERGENCE_COLUMNS,
     "phase_n6_cases.parquet": columns.RESULT_COLUMNS,
+    "phase_n4_cases.parquet": columns.RESULT_COLUMNS,
+    "phase_n8_cases.parquet": columns.RESULT_COLUMNS,
     "rest_study.parquet": columns.REST_STUDY_COLUMNS,
     "paper_range_rest_summary.parquet": columns.SUMMARY_COLUMNS,
     "paper_range_overview.parquet": columns.RANGE_OVERVIEW_COLUMNS,

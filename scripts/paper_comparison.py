@@ -1,14 +1,15 @@
 """Numbers of docs/studies/paper-comparison.md, from the tables scripts/make_figures.py writes.
 
-Usage: python scripts/paper_comparison.py [--runs runs] [--save-n6 data/phase_n6_cases.parquet]
+Usage: python scripts/paper_comparison.py [--runs runs] [--save-grids data]
 
 Reads (through ``loopsim.read_results``) the n = 6 grid (runs/phase_n6, the README's
 former main job), the same grid at n = 4 and n = 8, the 24 representative cases with --n auto
 (runs/resolved_auto; runs/resolved_n24 at fixed n = 24 when run with --n24) and the
 seed ensembles (n = 6, --n auto), and prints, per claim of the paper, the measured counts and
-ranges.  Missing tables are skipped with a note.  ``--save-n6 FILE`` also writes the n = 6
-grid's case table (without the coefficient column ``x_final``), every column described, the
-table that scripts/render_numbers.py renders the docs' n = 6 counts from.
+ranges.  Missing tables are skipped with a note.  ``--save-grids DIR`` also writes the case
+tables of the grids at n = 4, 6 and 8 (``DIR/phase_n<n>_cases.parquet``, without the
+coefficient column ``x_final``), every column described: the tables that
+scripts/render_numbers.py renders the docs' n = 6 counts and Fig. 9's from.
 """
 import argparse
 import os
@@ -131,8 +132,9 @@ def save_cases(frame, path):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--runs", default="runs")
-    parser.add_argument("--save-n6", metavar="FILE",
-                        help="also write the n = 6 grid's case table to FILE (Parquet)")
+    parser.add_argument("--save-grids", metavar="DIR",
+                        help="also write the case tables of the grids at n = 4, 6 and 8 to "
+                             "DIR/phase_n<n>_cases.parquet")
     args = parser.parse_args()
     tables = {name: load(args.runs, name) for name in
               ("phase_n6", "phase_n4", "phase_n8", "resolved_auto", "resolved_n24", "seeds_n6",
@@ -140,8 +142,9 @@ def main():
     for name, frame in tables.items():
         if frame is not None and len(frame):
             describe(name, frame)
-    if args.save_n6 and tables["phase_n6"] is not None:
-        save_cases(tables["phase_n6"], args.save_n6)
+    for name in ("phase_n4", "phase_n6", "phase_n8"):
+        if args.save_grids and tables[name] is not None:
+            save_cases(tables[name], os.path.join(args.save_grids, f"{name}_cases.parquet"))
     if tables["phase_n6"] is not None and tables["resolved_auto"] is not None:
         pairs(tables["phase_n6"], tables["resolved_auto"], "n = 6 grid against --n auto")
     if tables["resolved_auto"] is not None and tables["resolved_n24"] is not None:

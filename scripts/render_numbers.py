@@ -14,9 +14,11 @@ The tables:
 
 * ``data/phase_n6_cases.parquet``: the n = 6 grid (``loopsim sweep --g0 10:350:15
   --theta0 6:90:15 --n 6 --method rkf45 --no-twin``), one row per case, written by
-  ``python scripts/paper_comparison.py --save-n6``.  Its rows are not resolved, so its
-  counts move with rounding (another machine or BLAS may move a few cases between
-  regimes); the table is the run on the commit its metadata names.
+  ``python scripts/paper_comparison.py --save-grids data``, with the same grid at n = 4
+  (rkf45) and n = 8 (radau5) beside it (``phase_n4_cases``, ``phase_n8_cases``: Fig. 9).
+  Their rows are not resolved, so their counts move with rounding (another machine or
+  BLAS may move a few cases between regimes); each table is the run on the commit its
+  metadata names.
 * ``data/seeds_auto_grid_summary.parquet``: the main job's 72 points at ``--seeds auto``.
 * ``data/paper_range_runs/paper_range_top24``: the runs of g0 = 252.9-350 at 24-30 deg.
 * ``data/convergence_top.parquet`` and ``data/convergence_runs``: the convergence study at
@@ -169,6 +171,24 @@ def _n6_counts():
         "n6.band-3d": count((band["regime"] == "3d").sum()),
         "n6.band-in-plane": count((band["regime"] == "in-plane").sum()),
     }
+
+
+def _fig9_counts():
+    """Fig. 9's grids at n = 4 (rkf45) and n = 8 (radau5) beside the n = 6 one
+    (``data/phase_n<n>_cases.parquet``): ``fig9.n<n>.*``."""
+    out = {}
+    for n in (4, 8):
+        frame = table(f"phase_n{n}_cases.parquet")
+        d3 = frame[frame["regime"] == "3d"]
+        flat = (d3["theta_final_deg"] < FLAT_TILT_DEG) & (d3["aspect_ratio"] < ROUND_ASPECT)
+        out.update({f"fig9.n{n}.3d": count(len(d3)),
+                    f"fig9.n{n}.in-plane": count((frame["regime"] == "in-plane").sum()),
+                    f"fig9.n{n}.failed": count((frame["status"] != "ok").sum()),
+                    f"fig9.n{n}.3d-circles": count(flat.sum()),
+                    f"fig9.n{n}.boundary": (
+                        f"{frame[frame['regime'] == 'stable']['q0'].max():.2f} / "
+                        f"{frame[frame['regime'] != 'stable']['q0'].min():.2f}")})
+    return out
 
 
 def _n6_labels():
@@ -406,7 +426,7 @@ def _range_rest_cost():
 
 
 #: Groups of keys, each computed together from one table; a key's function is its group's.
-GROUPS = (_n6_counts, _n6_labels, _grid_costs, _top_costs, _tumbling_samples, _convergence,
+GROUPS = (_n6_counts, _n6_labels, _fig9_counts, _grid_costs, _top_costs, _tumbling_samples, _convergence,
           _rest_window, _rest_study, _range_overview, _range_rest_cost)
 
 
