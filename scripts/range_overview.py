@@ -55,9 +55,9 @@ def cell_key(g0, theta0):
 
 def finished_cells(path):
     """{cell key: rows} of the cells of the sweep at ``path`` whose every case has finished
-    (the sweep's case list, ``sweep_config``, says how many each has)."""
+    (the sweep's case list, in its ``_sweep.json``, says how many each has)."""
     frame = loopsim.read_results(path)
-    cases = pd.DataFrame(frame.attrs["loopsim"]["sweep_config"]["cases"])
+    cases = pd.DataFrame(storage.read_sweep_file(path)["config"]["cases"])
     wanted = cases.groupby(list(CELL)).size()
     out = {}
     for (g0, theta0), rows in frame.groupby(list(CELL)):

@@ -150,7 +150,7 @@ def tabulate_range(runs, out, window):
             frame = loopsim.read_results(path)
         except (FileNotFoundError, ValueError):
             continue
-        cases = len(frame.attrs["loopsim"]["sweep_config"]["cases"])
+        cases = len(storage.read_sweep_file(path)["config"]["cases"])
         if len(frame) < cases:
             print(f"range_rest_t{theta0}: {len(frame)} of {cases} cases, left out")
             continue
