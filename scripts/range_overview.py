@@ -38,13 +38,13 @@ import loopsim
 from loopsim import columns, outcome_statistics, storage
 from loopsim.intervals import wilson_interval
 from loopsim.stability import rest_window
+from loopsim.survival import PAPER_HORIZON
 
 #: The paper's grid: g0 = 10..350 in 15 values, θ0 = 6..90° in 15.
 G0 = np.linspace(10.0, 350.0, 15)
 THETA0 = np.linspace(6.0, 90.0, 15)
 #: The t = 10 tables, the first that holds a cell answering it.
 HORIZON_TABLES = ("paper_range_top_summary.parquet", "paper_range_summary.parquet")
-PAPER_HORIZON = 10.0
 CELL = ("g0", "theta0_deg")
 
 
