@@ -35,7 +35,7 @@ import pandas as pd
 import pyarrow as pa
 
 import loopsim
-from loopsim import columns, outcome_statistics, storage
+from loopsim import columns, outcome_statistics, storage, validation
 from loopsim.intervals import wilson_interval
 from loopsim.stability import rest_window
 from loopsim.survival import PAPER_HORIZON
@@ -142,8 +142,33 @@ def known_cells(path):
     try:
         held = pd.read_parquet(path, columns=[*CELL, "seeds"])
     except Exception as exc:  # noqa: BLE001 - any unreadable table is kept as it is
-        raise ValueError(f"{path!r} cannot be read to compare its rows ({exc})") from None
+        raise ValueError(f"{path!r} cannot be read to compare its rows ({exc}): nothing "
+                         "written over it; give another --out") from None
     return storage.study_keys(held[held["seeds"] > 0], CELL)
+
+
+def tabulate(args):
+    """(the overview table, the window, its metadata), or a one-line ValueError: an output
+    that cannot be written, nothing to tabulate under ``--data``, a bad ``--window-n``, or
+    a table at ``--out`` that knows a cell this run would not (it is kept as it is)."""
+    validation.check_output_file("--out", args.out)
+    validation.check_output_file("--figure", args.figure)
+    if not any(os.path.exists(os.path.join(args.data, name))
+               for name in (*HORIZON_TABLES, "rest_runs")):
+        raise ValueError(f"no committed table or rest_runs folder under --data {args.data!r}")
+    window = rest_window.stability_losses(args.window_n)
+    table = overview(args.data, window)
+    known = table[table["seeds"] > 0]
+    held = known_cells(args.out)
+    lost = held - storage.study_keys(known, CELL)
+    if lost:
+        g0, theta0 = sorted(lost)[0]
+        raise ValueError(f"{args.out} knows {len(held)} cells, this run only {len(known)} "
+                         f"(e.g. g0 = {g0:g}, theta0 = {theta0:g}): nothing written over it; "
+                         "give another --out")
+    meta = dict(sources=sorted(set(known["source"])), window=window.as_dict(),
+                intervals="95% Wilson or Kaplan-Meier log-log", loopsim_version=loopsim.__version__)
+    return table, window, meta
 
 
 def main(argv=None):
@@ -155,33 +180,24 @@ def main(argv=None):
     parser.add_argument("--window-n", type=int, default=rest_window.DEFAULT_WINDOW_N,
                         help="truncation order of the steady branch whose window is used")
     args = parser.parse_args(argv)
-    window = rest_window.stability_losses(args.window_n)
-    table = overview(args.data, window)
-    known = table[table["seeds"] > 0]
     try:
-        held = known_cells(args.out)
-        lost = held - storage.study_keys(known, CELL)
-        if lost:
-            g0, theta0 = sorted(lost)[0]
-            raise ValueError(f"{args.out} knows {len(held)} cells, this run only {len(known)} "
-                             f"(e.g. g0 = {g0:g}, theta0 = {theta0:g})")
+        table, window, meta = tabulate(args)
     except ValueError as exc:
-        print(f"range_overview: error: {exc}: nothing written over it; give another --out",
-              file=sys.stderr)
+        print(f"range_overview: error: {exc}", file=sys.stderr)
         sys.exit(2)
-    meta = dict(sources=sorted(set(known["source"])), window=window.as_dict(),
-                intervals="95% Wilson or Kaplan-Meier log-log", loopsim_version=loopsim.__version__)
-    arrow = pa.Table.from_pandas(table, preserve_index=False)
-    arrow = arrow.replace_schema_metadata(storage.provenance(
-        loopsim_range_overview=json.dumps(meta)))
-    storage.write_table_atomically(storage.described(arrow, columns.RANGE_OVERVIEW_COLUMNS),
-                                   args.out)
     import matplotlib
 
     matplotlib.use("Agg")
     from loopsim import figures
 
-    figures.save(figures.range_overview(table, window), args.figure, dpi=150)
+    figure = figures.range_overview(table, window)   # drawn before anything is written
+    arrow = pa.Table.from_pandas(table, preserve_index=False)
+    arrow = arrow.replace_schema_metadata(storage.provenance(
+        loopsim_range_overview=json.dumps(meta)))
+    storage.write_table_atomically(storage.described(arrow, columns.RANGE_OVERVIEW_COLUMNS),
+                                   args.out)
+    figures.save(figure, args.figure, dpi=150)
+    known = table[table["seeds"] > 0]
     by_source = known.groupby("t_max").size()
     print(f"wrote {args.out}: {len(known)} of {len(table)} cells known "
           + ", ".join(f"{n} at t_max = {t:g}" for t, n in by_source.items())

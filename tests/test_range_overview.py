@@ -98,3 +98,19 @@ def test_refuses_to_forget_a_known_cell(overview, tmp_path):
     done = run(out, tmp_path / "figure.png")
     assert done.returncode == 2 and "knows" in done.stderr and len(done.stderr.splitlines()) == 1
     assert pd.read_parquet(out)["seeds"].loc[gone] == 8 and not (tmp_path / "figure.png").exists()
+
+
+@pytest.mark.parametrize("bad", [["--data", "no-such-folder"], ["--window-n", "2"],
+                                 ["--figure", "FILE/overview.png"]])
+def test_bad_input_is_one_line_and_writes_nothing(tmp_path, bad):
+    blocker = tmp_path / "FILE"
+    blocker.write_text("")     # a file where a folder should be
+    out, figure = tmp_path / "overview.parquet", tmp_path / "overview.png"
+    argv = ["--data", DATA, "--out", str(out), "--figure", str(figure), "--window-n", "8"]
+    for option, value in zip(bad[::2], bad[1::2]):
+        argv[argv.index(option) + 1] = value.replace("FILE", str(blocker))
+    done = subprocess.run([sys.executable, SCRIPT, *argv], capture_output=True, text=True,
+                          cwd=str(tmp_path))
+    assert done.returncode == 2, done.stderr
+    assert done.stderr.startswith("range_overview: error:") and len(done.stderr.splitlines()) == 1
+    assert sorted(os.listdir(tmp_path)) == ["FILE"]

@@ -125,9 +125,9 @@ def range_overview(cells, window=None):
         threshold_curves(ax, window)
         ax.set_ylim(0, 1.06 * cells["g0"].max())
     late.set_ylabel("")
-    seeds = known["seeds"]
-    pies.set_title(f"regime probabilities per cell ({int(seeds.min())}-{int(seeds.max())} "
-                   "seeds)", fontsize=10)
+    seeds = sorted(set(int(k) for k in known["seeds"]))
+    pies.set_title("regime probabilities per cell" + (
+        f" ({seeds[0]}-{seeds[-1]} seeds)" if seeds else ": no cell run"), fontsize=10)
     late.set_title("what the paper's horizon hides: loops not at rest by t = 10", fontsize=10)
     handles, labels = merged_legend_entries([pies, late])
     fig.legend(handles, labels, fontsize=7, frameon=False, loc="lower center", ncol=4)
