@@ -52,7 +52,7 @@ import pandas as pd
 import pyarrow as pa
 
 import loopsim
-from loopsim import columns, outcome_statistics, storage
+from loopsim import columns, outcome_statistics, storage, validation
 from loopsim import distribution_differences as dd
 from loopsim.stability import rest_window
 
@@ -205,9 +205,15 @@ def main():
     args = parser.parse_args()
     if not args.read_only and shutil.which(args.loopsim) is None:
         sys.exit(f"rest_study: error: no loopsim executable at {args.loopsim!r}")
-    storage_dir = os.path.dirname(os.path.abspath(args.out))
-    if not os.path.isdir(storage_dir) or os.path.isdir(args.out):
-        sys.exit(f"rest_study: error: cannot write the table to {args.out!r}")
+    try:   # every output and the window's order, before any work
+        validation.check_output_file("--out", args.out)
+        validation.check_output_file("--range-out", args.range_out)
+        validation.check_output_directory("--figures", args.figures)
+        validation.check_count("--window-n", args.window_n, 4, validation.MAX_BRANCH_N,
+                               "the continuation's cost grows like n^3 per point")
+    except ValueError as exc:
+        print(f"rest_study: error: {exc}", file=sys.stderr)
+        sys.exit(2)
     frames, bases = {}, {}
     for name, g0, theta0, base in SWEEPS:
         path = os.path.join(args.runs, name)

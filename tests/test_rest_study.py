@@ -80,3 +80,22 @@ def test_the_keys_a_write_would_drop(tmp_path):
     path.write_bytes(b"not parquet")
     with pytest.raises(ValueError, match="cannot be read"):
         storage.keys_a_write_would_drop(str(path), one, cells)
+
+
+@pytest.mark.parametrize("bad", [["--window-n", "2"], ["--range-out", "FILE/range.parquet"],
+                                 ["--figures", "FILE/figures"]])
+def test_bad_input_is_one_line_and_writes_nothing(runs, bad):
+    """Checked before any work: the study's table was written before a bad --range-out
+    failed with a traceback."""
+    blocker = runs / "FILE"
+    blocker.write_text("")     # a file where a folder should be
+    argv = {"--window-n": "8", "--range-out": str(runs / "range.parquet"),
+            "--figures": str(runs / "figures")}
+    argv[bad[0]] = bad[1].replace("FILE", str(blocker))
+    done = subprocess.run([sys.executable, SCRIPT, "--read-only", "--runs", str(runs / "runs"),
+                           "--out", str(runs / "rest.parquet"),
+                           *[word for pair in argv.items() for word in pair]],
+                          capture_output=True, text=True, cwd=ROOT)
+    assert done.returncode == 2, done.stderr
+    assert done.stderr.startswith("rest_study: error:") and len(done.stderr.splitlines()) == 1
+    assert sorted(os.listdir(runs)) == ["FILE", "runs"]
