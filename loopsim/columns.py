@@ -136,6 +136,8 @@ SUMMARY_COLUMNS = {
     "resolved": (COUNT, "rows of the cell whose n_used resolves them"),
     "determined": (COUNT, "rows of the cell whose outcome is determined (a twin agreed; empty, "
                           "unknown, where no row of the cell ran a twin: --no-twin)"),
+    "twinned": (COUNT, "rows of the cell that ran a twin, whose determinacy is known (--seeds "
+                       "auto runs twins in its first round only)"),
     "steady": (COUNT, "rows of the cell that reached a steady state before t_end (stop_reason "
                       "steady); the others ran to t_end, their terminal values the state there, or "
                       "failed (empty, unknown, for a sweep run with --no-early-stop: no run was "
@@ -371,16 +373,18 @@ REST_STUDY_COLUMNS = {
 #: else a t = 10 table).
 RANGE_OVERVIEW_COLUMNS = {
     **{name: REST_STUDY_COLUMNS[name] for name in ("g0", "theta0_deg", "q0")},
-    "source": (TEXT, "the committed table or sweep the cell's row comes from (data/...); empty "
-                     "where the cell was never run"),
+    "source": (TEXT, "the committed table or sweep the cell's row comes from (data/...; an "
+                     "unfinished --seeds auto part with its finished rounds); empty where the "
+                     "cell was never run"),
     "t_max": (TIME, "the horizon its runs had (10: the paper's; 40: run to rest); NaN if not run"),
     "seeds": (COUNT, "rows (seeds) of the cell in its source (0: not run)"),
     **{name: SUMMARY_COLUMNS[name] for name in (
         "p_stable", "p_stable_low", "p_stable_high", "p_in_plane", "p_in_plane_low",
         "p_in_plane_high", "p_3d", "p_3d_low", "p_3d_high", "p_failed")},
     **{f"p_not_rest_t10{end}": (PROBABILITY, what) for end, what in (
-        ("", "P(not at rest by t = 10 t_u): the share of loops still moving (or failed) at the "
-             "paper's horizon; 1 - p_rest_t10, or 1 - steady / seeds for a t = 10 source"),
+        ("", "P(not at rest by t = 10 t_u): the share of the runs that did not fail still "
+             "moving at the paper's horizon; 1 - p_rest_t10, or 1 - steady / (seeds - failed) "
+             "for a t = 10 table without it"),
         ("_low", "lower end of its 95% interval (Wilson, or the Kaplan-Meier log-log band)"),
         ("_high", "upper end of its 95% interval"))},
     "at_rest": (COUNT, "rows that passed the steady test before t_max"),

@@ -7,10 +7,11 @@ whatever a grid or a cases file can set per case).  A cell holds each seed at mo
 two rows with one seed in one cell differ in an input the table does not record (an
 ``initial`` shape, say), and are refused rather than merged.  Per cell:
 
-* ``seeds``, ``resolved``, ``determined``, ``steady``: how many rows, and how many of
-  them are resolved and determined (``loopsim.outcomes``; ``determined`` unknown,
-  ``<NA>``, where no row of the cell ran a twin) and reached a steady state before
-  ``t_end`` (unknown, ``<NA>``, where a row ran without the early stop: ``rows_tested``);
+* ``seeds``, ``resolved``, ``determined``, ``twinned``, ``steady``: how many rows, and
+  how many of them are resolved and determined (``loopsim.outcomes``: a twin agreed;
+  ``twinned`` of them ran a twin, the others' determinacy is unknown, and ``determined``
+  is ``<NA>`` where no row did) and reached a steady state before ``t_end`` (unknown,
+  ``<NA>``, where a row ran without the early stop: ``rows_tested``);
 * ``p_<regime>`` for each regime, with its 95 % Wilson score interval (no continuity
   correction; ``scipy.stats.binomtest(k, N).proportion_ci(method="wilson")``)
   ``p_<regime>_low``, ``p_<regime>_high``:
@@ -100,9 +101,10 @@ def rows_tested(rows, tested=True):
 
 def _cell_row(rows, seed, tested=True, motion=True, window=None):
     trials = len(rows)
-    twinned = rows["determined"].notna().any()  # unknown (<NA>) where no row had a twin
+    twinned = int(rows["determined"].notna().sum())  # rows whose determinacy is known
     out = dict(seeds=trials, resolved=int(rows["resolved"].sum()),
-               determined=int(rows["determined"].eq(True).sum()) if twinned else pd.NA)
+               determined=int(rows["determined"].eq(True).sum()) if twinned else pd.NA,
+               twinned=twinned)
     if "stop_reason" in rows:  # unknown (<NA>) where a row was never tested
         out["steady"] = (int(rows["stop_reason"].eq("steady").sum())
                          if rows_tested(rows, tested) else pd.NA)

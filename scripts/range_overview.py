@@ -5,7 +5,8 @@ Usage: python scripts/range_overview.py [--data data] [--out data/paper_range_ov
                                         [--figure docs/figures/paper_range_overview.png]
                                         [--window-n 16]
 
-Runs nothing: it reads the committed tables and sweeps under ``--data``.
+Runs nothing: it reads the committed tables and sweeps under ``--data``, in this order of
+precedence:
 
 * Run to rest (``t_max`` 40): the sweeps under ``DATA/rest_runs`` (``scripts/rest_study.py``:
   the four 16-seed cells of the study, and the ``range_rest_t<θ0>`` sweeps, 8 seeds per
@@ -14,15 +15,21 @@ Runs nothing: it reads the committed tables and sweeps under ``--data``.
   window.  A cell in several sweeps takes the one with the most seeds.
 * At the paper's horizon (``t_max`` 10): ``DATA/paper_range_top_summary.parquet`` and
   ``DATA/paper_range_summary.parquet`` (``scripts/paper_range_study.py``, ``--seeds auto``
-  with twins), for the cells not run to rest.  Their P(not at rest by t = 10) is
-  1 - steady / seeds (the steady test is what "at rest" means), with its Wilson interval.
+  with twins).
+* At the paper's horizon, unfinished: the ``--seeds auto`` parts under
+  ``DATA/paper_range_runs`` that have not finished, each cell with the rounds it has
+  finished (a round's fast seeds finish first, so a round counts only whole).
 * A cell in none of them is a row with ``seeds`` 0 and an empty ``source``.
+
+P(not at rest by t = 10) is over the runs that did not fail: 1 - ``p_rest_t10`` where the
+source has it, else 1 - steady / (seeds - failed) with its Wilson interval (the steady
+test is what "at rest" means).
 
 Writes ``--out`` (columns: ``loopsim.columns.RANGE_OVERVIEW_COLUMNS``, each described;
 225 rows, one per cell) and ``--figure`` (``loopsim.figures.range_overview``: the regime
 probabilities and P(not at rest by t = 10) per cell, the thresholds and the stable
-branch's upper edge).  It refuses (exit status 2, nothing written) where the table at
-``--out`` knows a cell that this run would not.
+branch's upper edge).  It refuses (exit status 2, nothing written) where ``--out`` holds
+another kind of table, or an overview that knows a cell this run would not.
 """
 import argparse
 import glob
@@ -33,6 +40,7 @@ import sys
 import numpy as np
 import pandas as pd
 import pyarrow as pa
+import pyarrow.parquet as pq
 
 import loopsim
 from loopsim import columns, outcome_statistics, storage, validation
@@ -55,10 +63,17 @@ def cell_key(g0, theta0):
 
 def finished_cells(path):
     """{cell key: rows} of the cells of the sweep at ``path`` whose every case has finished
-    (the sweep's case list, in its ``_sweep.json``, says how many each has)."""
-    frame = loopsim.read_results(path)
-    cases = pd.DataFrame(storage.read_sweep_file(path)["config"]["cases"])
-    wanted = cases.groupby(list(CELL)).size()
+    (the sweep's case list, in its ``_sweep.json``, says how many each has); none for a
+    folder that is not (yet) a sweep."""
+    try:
+        frame = loopsim.read_results(path)
+        record = storage.read_sweep_file(path)
+    except (FileNotFoundError, ValueError) as exc:
+        print(f"{path}: left out ({exc})", file=sys.stderr)
+        return {}
+    if record is None:
+        return {}
+    wanted = pd.DataFrame(record["config"]["cases"]).groupby(list(CELL)).size()
     out = {}
     for (g0, theta0), rows in frame.groupby(list(CELL)):
         if len(rows) == wanted.get((g0, theta0), -1):
@@ -66,8 +81,15 @@ def finished_cells(path):
     return out
 
 
+def summarised(cells, window):
+    """{cell key: (source, t_max, summary row)} from {cell key: (source, rows)}."""
+    return {key: (source, float(rows["t_end"].max()),
+                  outcome_statistics.summarize(rows, rest_window=window).iloc[0])
+            for key, (source, rows) in cells.items()}
+
+
 def rest_cells(data, window):
-    """{cell key: summary row} of the cells run to rest, the largest sample of each."""
+    """The cells run to rest, the largest sample of each."""
     best = {}
     for path in sorted(glob.glob(os.path.join(data, "rest_runs", "*rest_t*"))):
         if not os.path.isdir(path):
@@ -75,26 +97,43 @@ def rest_cells(data, window):
         for key, rows in finished_cells(path).items():
             if key not in best or len(rows) > len(best[key][1]):
                 best[key] = (os.path.relpath(path, os.path.dirname(data)), rows)
-    out = {}
-    for key, (source, rows) in best.items():
-        row = outcome_statistics.summarize(rows, rest_window=window).iloc[0]
-        out[key] = overview_row(row, source, float(rows["t_end"].max()))
-    return out
+    return summarised(best, window)
 
 
 def horizon_cells(data):
-    """{cell key: summary row} of the cells of the t = 10 tables (the first table wins)."""
+    """The cells of the t = 10 tables (the first table wins)."""
     out = {}
     for name in HORIZON_TABLES:
         path = os.path.join(data, name)
         if not os.path.exists(path):
             continue
         for _, row in pd.read_parquet(path).iterrows():
-            key = cell_key(row["g0"], row["theta0_deg"])
-            if key not in out:
-                out[key] = overview_row(row, os.path.join(os.path.basename(data), name),
-                                        PAPER_HORIZON)
+            out.setdefault(cell_key(row["g0"], row["theta0_deg"]),
+                           (os.path.join(os.path.basename(data), name), PAPER_HORIZON, row))
     return out
+
+
+def unfinished_part_cells(data, window):
+    """The cells of the unfinished ``--seeds auto`` parts under ``DATA/paper_range_runs``
+    (no stop table yet), each with its rounds up to the first it has not finished."""
+    found = {}
+    for part in sorted(glob.glob(os.path.join(data, "paper_range_runs", "*"))):
+        if os.path.isfile(os.path.join(part, storage.STOPS_FILE)):
+            continue   # finished: in the t = 10 tables
+        source = os.path.relpath(part, os.path.dirname(data)) + " (unfinished)"
+        cells, growing = {}, set()
+        for number, path in enumerate(sorted(glob.glob(os.path.join(part, "round-*")))):
+            done = finished_cells(path)
+            if number == 0:
+                cells, growing = dict(done), set(done)
+                continue
+            for key in sorted(growing):
+                if key in done:
+                    cells[key] = pd.concat([cells[key], done[key]], ignore_index=True)
+                else:   # not in this round, or not finished in it: no later round counts
+                    growing.discard(key)
+        found.update({key: (source, rows) for key, rows in cells.items()})
+    return summarised(found, window)
 
 
 def overview_row(row, source, t_max):
@@ -107,22 +146,28 @@ def overview_row(row, source, t_max):
         out["p_not_rest_t10"] = 1.0 - row["p_rest_t10"]
         out["p_not_rest_t10_low"] = 1.0 - row["p_rest_t10_high"]
         out["p_not_rest_t10_high"] = 1.0 - row["p_rest_t10_low"]
-    else:   # a table of the paper's horizon without the settling statistics
-        moving = seeds - int(row["steady"])
-        out["p_not_rest_t10"] = moving / seeds
-        out["p_not_rest_t10_low"], out["p_not_rest_t10_high"] = wilson_interval(moving, seeds)
-    out["at_rest"] = row["at_rest"] if "at_rest" in row else row["steady"]
+        out["at_rest"] = row["at_rest"]
+    elif pd.notna(row.get("steady")):   # a t = 10 table without the settling statistics
+        observed = seeds - int(round(row["p_failed"] * seeds))
+        moving = observed - int(row["steady"])
+        if observed:
+            out["p_not_rest_t10"] = moving / observed
+            out["p_not_rest_t10_low"], out["p_not_rest_t10_high"] = wilson_interval(moving,
+                                                                                    observed)
+        out["at_rest"] = row["steady"]
     return out
 
 
 def overview(data, window):
     """The 225-row table: each cell from the run-to-rest sweeps, else the t = 10 tables,
-    else empty."""
-    found = {**horizon_cells(data), **rest_cells(data, window)}   # run to rest wins
+    else the unfinished t = 10 parts, else empty."""
+    found = {**unfinished_part_cells(data, window), **horizon_cells(data),
+             **rest_cells(data, window)}   # later sources win
     rows = []
     for theta0 in THETA0:
         for g0 in G0:
-            row = found.get(cell_key(g0, theta0))
+            key = cell_key(g0, theta0)
+            row = overview_row(found[key][2], *found[key][:2]) if key in found else None
             if row is None:
                 row = {name: np.nan for name in columns.RANGE_OVERVIEW_COLUMNS}
                 row.update(g0=g0, theta0_deg=theta0, q0=g0 * np.sin(np.radians(theta0)) / 3,
@@ -140,6 +185,8 @@ def known_cells(path):
     if not os.path.isfile(path):
         return set()
     try:
+        if b"loopsim_range_overview" not in (pq.read_schema(path).metadata or {}):
+            raise ValueError("it is not a range overview")
         held = pd.read_parquet(path, columns=[*CELL, "seeds"])
     except Exception as exc:  # noqa: BLE001 - any unreadable table is kept as it is
         raise ValueError(f"{path!r} cannot be read to compare its rows ({exc}): nothing "
@@ -151,6 +198,7 @@ def tabulate(args):
     """(the overview table, the window, its metadata), or a one-line ValueError: an output
     that cannot be written, nothing to tabulate under ``--data``, a bad ``--window-n``, or
     a table at ``--out`` that knows a cell this run would not (it is kept as it is)."""
+    args.data = os.path.normpath(args.data)   # "data/" names its sources as "data" does
     validation.check_output_file("--out", args.out)
     validation.check_output_file("--figure", args.figure)
     if not any(os.path.exists(os.path.join(args.data, name))

@@ -389,7 +389,8 @@ def _range_overview():
             if r["seeds"] == 0:
                 entries.append("not run")
                 continue
-            where = "to rest" if r["t_max"] > 10 else "t = 10"
+            where = "to rest" if r["t_max"] > 10 else (
+                "t = 10, unfinished" if "unfinished" in r["source"] else "t = 10")
             entries.append(f"{r['p_3d']:.2f} / {r['p_not_rest_t10']:.2f} "
                            f"({int(r['seeds'])}, {where})")
         rows.append(f"| {theta0:.0f}° | " + " | ".join(entries) + " |")
@@ -412,13 +413,22 @@ def _range_overview():
 
 
 def _range_rest_cost():
-    """What a loop run to rest costs at the top of the range: the rows of every
-    ``data/rest_runs/range_rest_t*`` sweep so far (``wall_s``, 2 shared cores)."""
-    paths = sorted(glob.glob(os.path.join(DATA, "rest_runs", "range_rest_t*")))
-    if not paths:
+    """What a loop run to rest costs at the top of the range: the rows of every finished
+    ``data/rest_runs/range_rest_t*`` sweep (``wall_s``, 2 shared cores; a sweep still
+    running has its slow cases still to come, so it is left out)."""
+    from loopsim import storage
+
+    walls, tilts = [], []
+    for path in sorted(glob.glob(os.path.join(DATA, "rest_runs", "range_rest_t*"))):
+        rows = table(os.path.relpath(path, DATA))
+        if len(rows) and len(rows) == len(storage.read_sweep_file(path)["config"]["cases"]):
+            walls.append(rows["wall_s"])
+            tilts.append(int(rows["theta0_deg"].iloc[0]))
+    if not walls:
         return {}
-    walls = pd.concat([table(os.path.relpath(p, DATA))["wall_s"] for p in paths]).to_numpy(float)
+    walls = pd.concat(walls).to_numpy(float)
     return {"range.rest-runs": count(walls.size),
+            "range.rest-tilts": f"{min(tilts)}–{max(tilts)}°",
             "range.rest-sample-median": f"{np.median(walls):.0f} s",
             "range.rest-sample-span": f"{walls.min():.1f}–{walls.max():.0f} s",
             "range.rest-cell-hours": f"{8 * walls.mean() / 3600:.2f} h",

@@ -139,10 +139,9 @@ RANGE_SEEDS = 8
 RANGE_OUT = os.path.join("data", "paper_range_rest_summary.parquet")
 
 
-def tabulate_range(runs, out, window):
+def tabulate_range(runs, window):
     """``loopsim.summarize`` of every finished range sweep in ``runs`` (with the rest
-    window), written to ``out`` as a summary table (``SUMMARY_COLUMNS``); a table that
-    would lose cells is refused like the study's own."""
+    window), or None where none has finished."""
     frames = []
     for theta0 in RANGE_THETA0:
         path = os.path.join(runs, f"range_rest_t{theta0}")
@@ -156,10 +155,13 @@ def tabulate_range(runs, out, window):
             continue
         frames.append(frame)
     if not frames:
-        return
-    table = outcome_statistics.summarize(pd.concat(frames, ignore_index=True),
-                                         rest_window=window)
-    refuse_to_shrink(table, out)
+        return None
+    return outcome_statistics.summarize(pd.concat(frames, ignore_index=True),
+                                        rest_window=window)
+
+
+def write_range(table, out):
+    """Write the range sweeps' summary to ``out`` (``SUMMARY_COLUMNS``)."""
     arrow = pa.Table.from_pandas(table, preserve_index=False)
     arrow = arrow.replace_schema_metadata(storage.provenance(loopsim_summary=json.dumps(
         dict(table.attrs["loopsim_summary"], summary_of="data/rest_runs/range_rest_t*",
@@ -168,21 +170,21 @@ def tabulate_range(runs, out, window):
     print(f"wrote {out}: {len(table)} cells")
 
 
-def refuse_to_shrink(table, out):
-    """Exit 2 if ``out`` holds a cell that ``table`` lacks (a partial run would shrink a
-    committed table)."""
+def refuse_to_shrink(table, out, option):
+    """Exit 2 if the table at ``out`` (the path given as ``option``) holds a cell that
+    ``table`` lacks (a partial run would shrink a committed table), or cannot be read."""
     cells = ("g0", "theta0_deg")
     try:
         held, lost = storage.keys_a_write_would_drop(out, storage.study_keys(table, cells), cells)
     except ValueError as exc:
-        print(f"rest_study: error: {exc}: nothing written over it; give another --out",
+        print(f"rest_study: error: {exc}: nothing written over it; give another {option}",
               file=sys.stderr)
         sys.exit(2)
     if lost:
         g0, theta0 = sorted(lost)[0]
         print(f"rest_study: error: {out} holds {len(held)} cells, this run only {len(table)} "
-              f"(e.g. g0 = {g0:g}, theta0 = {theta0:g} is missing); give another --out",
-              file=sys.stderr)
+              f"(e.g. g0 = {g0:g}, theta0 = {theta0:g} is missing); nothing written; give "
+              f"another {option}", file=sys.stderr)
         sys.exit(2)
 
 
@@ -209,6 +211,8 @@ def main():
         validation.check_output_file("--out", args.out)
         validation.check_output_file("--range-out", args.range_out)
         validation.check_output_directory("--figures", args.figures)
+        if os.path.realpath(args.out) == os.path.realpath(args.range_out):
+            raise ValueError(f"--out and --range-out are one file, {args.out!r}")
         validation.check_count("--window-n", args.window_n, 4, validation.MAX_BRANCH_N,
                                "the continuation's cost grows like n^3 per point")
     except ValueError as exc:
@@ -238,7 +242,10 @@ def main():
         sys.exit("rest_study: no sweep has finished")
     window = rest_window.stability_losses(args.window_n)
     table = tabulate(frames, bases, window)
-    refuse_to_shrink(table, args.out)
+    range_table = tabulate_range(args.runs, window)
+    refuse_to_shrink(table, args.out, "--out")   # both checked before anything is written
+    if range_table is not None:
+        refuse_to_shrink(range_table, args.range_out, "--range-out")
     meta = dict(ensemble=ENSEMBLE, seeds=f"0-{SEEDS - 1}", sweeps=list(frames),
                 options=" ".join(OPTIONS), t_max=T_MAX,
                 window=window.as_dict(), intervals="95% Wilson or Kaplan-Meier log-log (P), "
@@ -256,7 +263,8 @@ def main():
     rows = pd.concat(frames.values(), ignore_index=True)
     figures.save(figures.survival_curves(rows), os.path.join(args.figures, "rest_survival.png"))
     figures.save(figures.rest_tilts(rows, window), os.path.join(args.figures, "rest_tilts.png"))
-    tabulate_range(args.runs, args.range_out, window)
+    if range_table is not None:
+        write_range(range_table, args.range_out)
     with pd.option_context("display.width", 220, "display.max_columns", 40):
         shown = ["g0", "theta0_deg", "q0", "seeds", "at_rest", "moving_at_t_max",
                  "p_rest_t10", "t_rest_median", "t_rest_q95", "rest_inside", "rest_below",

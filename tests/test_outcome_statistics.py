@@ -378,3 +378,9 @@ def test_determined_is_unknown_where_no_row_ran_a_twin(tmp_path, capsys):
     undetermined = both.assign(determined=pd.array([pd.NA, 1], dtype="Int64"))
     labels = figures.probability_phase_diagram(undetermined).axes[0].get_legend_handles_labels()[1]
     assert "some seeds not determined" in labels
+    # the review's case: a --seeds auto cell, twins in its first round only, all agreeing
+    mixed = outcome_statistics.summarize(pd.concat([b, b.assign(seed=b["seed"] + 2,
+                                                                determined=None)]))
+    assert (mixed["seeds"].iloc[0], mixed["twinned"].iloc[0], mixed["determined"].iloc[0]) == (4, 2, 2)
+    labels = figures.probability_phase_diagram(mixed).axes[0].get_legend_handles_labels()[1]
+    assert "some seeds not determined" not in labels

@@ -2,11 +2,13 @@
 study that answers it best, checked against the sources it reads; its refusal to forget a
 cell."""
 import os
+import shutil
 import subprocess
 import sys
 
 import numpy as np
 import pandas as pd
+import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
@@ -94,10 +96,38 @@ def test_refuses_to_forget_a_known_cell(overview, tmp_path):
     gone = table.index[table["seeds"] == 0][0]
     table.loc[gone, "seeds"] = 8       # a cell this run does not know
     out = tmp_path / "overview.parquet"
-    table.to_parquet(out)
+    pq.write_table(pa.Table.from_pandas(table, preserve_index=False).replace_schema_metadata(
+        pq.read_schema(overview["out"]).metadata), out)   # an overview knowing one more cell
     done = run(out, tmp_path / "figure.png")
     assert done.returncode == 2 and "knows" in done.stderr and len(done.stderr.splitlines()) == 1
     assert pd.read_parquet(out)["seeds"].loc[gone] == 8 and not (tmp_path / "figure.png").exists()
+
+
+def test_refuses_to_write_over_another_kind_of_table(tmp_path):
+    """The review's case: a copy of one of its own inputs at --out has the same cells, and
+    was replaced."""
+    out = tmp_path / "top.parquet"
+    shutil.copy(os.path.join(DATA, "paper_range_top_summary.parquet"), out)
+    before = out.read_bytes()
+    done = run(out, tmp_path / "figure.png")
+    assert done.returncode == 2 and "not a range overview" in done.stderr, done.stderr
+    assert out.read_bytes() == before and not (tmp_path / "figure.png").exists()
+
+
+def test_unfinished_parts_give_their_finished_rounds(overview):
+    """A cell of the unfinished --seeds auto part at 24-30 deg is answered by its finished
+    rounds only: (350, 30) by its two (8 seeds), (277.1, 30) by its first (4: its second
+    round has 2 of 4 seeds)."""
+    table = overview["table"]
+    part = os.path.join(DATA, "paper_range_runs", "paper_range_top24")
+    first = loopsim.read_results(os.path.join(part, "round-00"))
+    for g0, seeds in ((350.0, 8), (277.142857143, 4)):
+        row = cell(table, g0, 30.0)
+        assert row["source"] == "data/paper_range_runs/paper_range_top24 (unfinished)"
+        assert row["seeds"] == seeds and row["t_max"] == 10.0
+    rows = first[np.isclose(first["g0"], 277.142857143) & (first["theta0_deg"] == 30.0)]
+    moving = int((rows["stop_reason"] != "steady").sum())
+    assert cell(table, 277.142857143, 30.0)["p_not_rest_t10"] == pytest.approx(moving / len(rows))
 
 
 @pytest.mark.parametrize("bad", [["--data", "no-such-folder"], ["--window-n", "2"],

@@ -99,3 +99,24 @@ def test_bad_input_is_one_line_and_writes_nothing(runs, bad):
     assert done.returncode == 2, done.stderr
     assert done.stderr.startswith("rest_study: error:") and len(done.stderr.splitlines()) == 1
     assert sorted(os.listdir(runs)) == ["FILE", "runs"]
+
+
+def test_a_range_table_that_would_shrink_is_refused_before_anything_is_written(runs):
+    """The review's case: the study's table and figures were written, then --range-out
+    was refused."""
+    shutil.copytree(os.path.join(ROOT, "data", "rest_runs", "range_rest_t36"),
+                    runs / "runs" / "range_rest_t36")
+    fuller = runs / "range.parquet"
+    shutil.copy(os.path.join(ROOT, "data", "paper_range_rest_summary.parquet"), fuller)
+    before = fuller.read_bytes()
+    done = subprocess.run([sys.executable, SCRIPT, "--read-only", "--runs", str(runs / "runs"),
+                           "--out", str(runs / "rest.parquet"), "--figures", str(runs / "figs"),
+                           "--range-out", str(fuller), "--window-n", "8"],
+                          capture_output=True, text=True, cwd=ROOT)
+    assert done.returncode == 2 and "give another --range-out" in done.stderr, done.stderr
+    assert sorted(os.listdir(runs)) == ["range.parquet", "runs"]
+    assert fuller.read_bytes() == before
+    same = subprocess.run([sys.executable, SCRIPT, "--read-only", "--runs", str(runs / "runs"),
+                           "--out", str(fuller), "--range-out", str(fuller)],
+                          capture_output=True, text=True, cwd=ROOT)
+    assert same.returncode == 2 and "are one file" in same.stderr

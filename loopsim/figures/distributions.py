@@ -68,7 +68,8 @@ def probability_phase_diagram(cells, frame=None, ax=None, style="pie", rest_wind
     (``loopsim.summarize``) at (θ0, g0) as a pie of its regime probabilities
     (``style="pie"``, :func:`regime_pies`) or coloured by its probability of ending 3D
     (``style="colour"``, labelled with P(in-plane) when it is neither 0 nor 1); ringed
-    red where any seed is not determined, marked by a black triangle where any seed had
+    red where a seed's twin ended elsewhere (not determined; seeds run without a twin
+    are not counted), marked by a black triangle where any seed had
     not reached a steady state at ``t_end`` (its tilt is then a snapshot: only when some
     run of the table did stop early, so not for ``--no-early-stop``), with P(not at rest
     by t = 10) beside it where the table has ``p_rest_t10``; with the full
@@ -91,8 +92,9 @@ def probability_phase_diagram(cells, frame=None, ax=None, style="pie", rest_wind
         for _, cell in cells[(cells["p_in_plane"] > 0) & (cells["p_in_plane"] < 1)].iterrows():
             ax.annotate(f"{cell['p_in_plane']:.2f}", (cell["theta0_deg"], cell["g0"]),
                         textcoords="offset points", xytext=(0, 7), ha="center", fontsize=6)
-    mixed = cells[(cells["determined"] < cells["seeds"]).fillna(False).astype(bool)]
-    # (a cell whose determined is unknown, <NA>: no twin ran, is not ringed)
+    known = cells["twinned"] if "twinned" in cells else cells["seeds"]  # (older tables)
+    mixed = cells[(cells["determined"] < known).fillna(False).astype(bool)]
+    # (ringed where a twin ended elsewhere; rows without a twin are unknown, not ringed)
     if len(mixed):
         ax.scatter(mixed["theta0_deg"], mixed["g0"], s=230 if style == "pie" else 150,
                    facecolors="none", edgecolors="#d62728", linewidths=0.9, zorder=4,
