@@ -95,3 +95,15 @@ def test_a_path_longer_than_the_system_takes_is_one_line(tmp_path, capsys):
     assert err.startswith("loopsim: error:") and len(err.splitlines()) == 1
     assert "File name too long" in err
     assert os.listdir(tmp_path) == []  # the levels it could make are removed again
+
+
+def test_a_file_name_past_the_limit_in_directories_that_fit_leaves_none(deep, tmp_path, capsys):
+    """The review's case: the directories fit under PATH_MAX (4 096), the file in them does
+    not; the write failed after every level was made and left 2 033 of them."""
+    levels = (4080 - len(str(tmp_path))) // 2
+    out = os.path.join(str(tmp_path), *["d"] * levels, "s.parquet")
+    assert len(os.path.dirname(out)) < 4096 <= len(out) + 30
+    assert main(["summary", deep["sweep"], "--out", out]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("loopsim: error:") and len(err.splitlines()) == 1
+    assert os.listdir(tmp_path) == []

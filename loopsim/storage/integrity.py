@@ -50,8 +50,9 @@ def make_directories(path):
     """``os.makedirs(path, exist_ok=True)`` without its recursion (one call per level: a
     legal path 1 000 directories deep exhausted Python's stack): the missing directories
     are made from the outermost in, each with the umask's mode, and removed again if a
-    deeper one cannot be made (ENAMETOOLONG past PATH_MAX).  FileExistsError where a
-    component is a file."""
+    deeper one cannot be made (ENAMETOOLONG past PATH_MAX).  Returns the directories it
+    made, outermost first (for :func:`remove_directories` when what goes in them fails).
+    FileExistsError where a component is a file."""
     path = os.path.abspath(os.fspath(path))
     missing = []
     while not os.path.isdir(path):
@@ -70,12 +71,19 @@ def make_directories(path):
                 if not os.path.isdir(directory):
                     raise
     except OSError:
-        for directory in reversed(made):  # nothing half-made is left behind
-            try:
-                os.rmdir(directory)
-            except OSError:
-                break
+        remove_directories(made)   # nothing half-made is left behind
         raise
+    return made
+
+
+def remove_directories(made):
+    """Remove the directories ``make_directories`` returned, innermost first, as far as
+    they are empty (another process may have written into one meanwhile)."""
+    for directory in reversed(made):
+        try:
+            os.rmdir(directory)
+        except OSError:
+            break
 
 
 def _umask():
@@ -93,18 +101,23 @@ def _umask():
 
 
 def _temporary(directory, suffix):
-    """(fd, path) of a new temporary file in ``directory`` named for this host and process,
+    """(fd, path, the directories made for it) of a new temporary file in ``directory``
+    named for this host and process,
     with the mode an ordinary ``open`` gives (0666 less the umask; mkstemp's is 0600),
     registered for removal should a signal end the process at once
     (``_signals.remove_temporaries``).  The directory is made if absent (output paths are
     checked before any work); the temporaries that dead processes left in it are removed
     first (:func:`remove_stale_temporaries`)."""
-    make_directories(directory)
-    remove_stale_temporaries(directory)
-    fd, tmp = tempfile.mkstemp(prefix=_temporary_prefix(), suffix=suffix, dir=directory)
+    made = make_directories(directory)
+    try:
+        remove_stale_temporaries(directory)
+        fd, tmp = tempfile.mkstemp(prefix=_temporary_prefix(), suffix=suffix, dir=directory)
+    except OSError:   # a name past PATH_MAX in directories that fit: remove those made here
+        remove_directories(made)
+        raise
     track_temporary(tmp)
     os.fchmod(fd, 0o666 & ~_umask())
-    return fd, tmp
+    return fd, tmp, made
 
 
 def write_json_atomically(data, path):
@@ -123,7 +136,8 @@ def write_file_atomically(path, write):
     is there whole or not at all (a full disk leaves no empty or partial file, an
     exception or a signal no temporary; the temporaries of dead processes in that
     directory are removed first)."""
-    fd, tmp = _temporary(os.path.dirname(os.path.abspath(path)), os.path.splitext(path)[1])
+    fd, tmp, made = _temporary(os.path.dirname(os.path.abspath(path)),
+                               os.path.splitext(path)[1])
     os.close(fd)
     try:
         write(tmp)
@@ -131,6 +145,7 @@ def write_file_atomically(path, write):
     except BaseException:
         if os.path.exists(tmp):
             os.remove(tmp)
+        remove_directories(made)   # a target's name past PATH_MAX leaves no directories
         raise
     finally:
         untrack_temporary(tmp)
