@@ -102,12 +102,11 @@ def _umask():
 
 def _temporary(directory, suffix):
     """(fd, path, the directories made for it) of a new temporary file in ``directory``
-    named for this host and process,
-    with the mode an ordinary ``open`` gives (0666 less the umask; mkstemp's is 0600),
-    registered for removal should a signal end the process at once
-    (``_signals.remove_temporaries``).  The directory is made if absent (output paths are
-    checked before any work); the temporaries that dead processes left in it are removed
-    first (:func:`remove_stale_temporaries`)."""
+    named for this host and process, with the mode an ordinary ``open`` gives (0666 less
+    the umask; mkstemp's is 0600), registered for removal should a signal end the process
+    at once (``_signals.remove_temporaries``).  The directory is made if absent (output
+    paths are checked before any work); the temporaries that dead processes left in it
+    are removed first (:func:`remove_stale_temporaries`)."""
     made = make_directories(directory)
     try:
         remove_stale_temporaries(directory)
