@@ -412,21 +412,27 @@ def _range_overview():
             "range.top-table": "\n\n" + "\n".join(rows) + "\n\n"}
 
 
-def _range_rest_cost():
-    """What a loop run to rest costs at the top of the range: the rows of every finished
-    ``data/rest_runs/range_rest_t*`` sweep (``wall_s``, 2 shared cores; a sweep still
-    running has its slow cases still to come, so it is left out)."""
+def _finished_range_rest_sweeps():
+    """The rows of every finished ``data/rest_runs/range_rest_t*`` sweep, one frame each
+    (a sweep still running has its slow cases still to come, so it is left out)."""
     from loopsim import storage
 
-    walls, tilts = [], []
+    frames = []
     for path in sorted(glob.glob(os.path.join(DATA, "rest_runs", "range_rest_t*"))):
         rows = table(os.path.relpath(path, DATA))
         if len(rows) and len(rows) == len(storage.read_sweep_file(path)["config"]["cases"]):
-            walls.append(rows["wall_s"])
-            tilts.append(int(rows["theta0_deg"].iloc[0]))
-    if not walls:
+            frames.append(rows)
+    return frames
+
+
+def _range_rest_cost():
+    """What a loop run to rest costs at the top of the range: ``wall_s`` of the finished
+    range sweeps' rows (2 shared cores)."""
+    frames = _finished_range_rest_sweeps()
+    if not frames:
         return {}
-    walls = pd.concat(walls).to_numpy(float)
+    walls = pd.concat(frames)["wall_s"].to_numpy(float)
+    tilts = [int(rows["theta0_deg"].iloc[0]) for rows in frames]
     return {"range.rest-runs": count(walls.size),
             "range.rest-tilts": f"{min(tilts)}–{max(tilts)}°",
             "range.rest-sample-median": f"{np.median(walls):.0f} s",
@@ -435,9 +441,50 @@ def _range_rest_cost():
             "range.rest-cells60-hours": f"{60 * 8 * walls.mean() / 3600:.0f} h"}
 
 
+#: Onsets (t_u) at which the pooled tail's escape rate is estimated: a constant rate
+#: from each onset on is an exponential (memoryless) tail.
+TAIL_ONSETS = (10.0, 15.0, 20.0)
+
+
+def _range_rest_pooled():
+    """Every loop of the finished range sweeps pooled (``range.pooled-*``): how many came
+    to rest by t_max (and those that did not, with their ``terminal_state``), P(at rest
+    by t = 10), the time by which 95 % rest, the latest
+    settling time, and the escape rate after each of :data:`TAIL_ONSETS`, with the
+    share of the loops moving at t = 10 that such a tail leaves moving at t_max."""
+    from loopsim import survival
+
+    frames = _finished_range_rest_sweeps()
+    if not frames:
+        return {}
+    rows = pd.concat(frames, ignore_index=True)
+    pooled = survival.settling_statistics(rows)
+    times, at_rest = survival.settling_times(rows)
+    t_max = float(rows["t_end"].max())
+    out = {"range.pooled-loops": count(pooled["rest_observed"]),
+           "range.pooled-at-rest": count(pooled["at_rest"]),
+           "range.pooled-p10": _interval(pooled["p_rest_t10"], pooled["p_rest_t10_low"],
+                                         pooled["p_rest_t10_high"], 2),
+           "range.pooled-q95": f"{pooled['t_rest_q95']:.1f}",
+           "range.pooled-latest": f"{times[at_rest].max():.1f}",
+           "range.pooled-t-max": f"{t_max:g}"}
+    for onset in TAIL_ONSETS:
+        rate, low, high, events, _ = survival.escape_rate(times, at_rest, onset)
+        out[f"range.pooled-escape-{onset:g}"] = (
+            f"{_interval(rate, low, high, 2)} ({events} events)")
+    moving = rows[rows["stop_reason"].eq("t_end")]
+    out["range.pooled-left"] = "; ".join(
+        f"({r['g0']:.1f}, {r['theta0_deg']:.0f}°) seed {r['seed']}, {r['terminal_state']}"
+        for _, r in moving.iterrows()) or "none"
+    rate = survival.escape_rate(times, at_rest)[0]
+    out["range.pooled-tail-left"] = f"{np.exp(-rate * (t_max - survival.PAPER_HORIZON)):.0e}"
+    return out
+
+
 #: Groups of keys, each computed together from one table; a key's function is its group's.
 GROUPS = (_n6_counts, _n6_labels, _fig9_counts, _grid_costs, _top_costs, _tumbling_samples, _convergence,
-          _rest_window, _rest_study, _range_overview, _range_rest_cost)
+          _rest_window, _rest_study, _range_overview, _range_rest_cost,
+          _range_rest_pooled)
 
 
 @functools.lru_cache(maxsize=None)

@@ -63,3 +63,18 @@ def test_the_pages_mark_what_they_quote_from_the_tables():
     assert {"n6.3d-tilt-quartiles", "n6.steady", "n6.3d-circles"} <= keys[
         os.path.join("docs", "studies", "paper-comparison.md")]
     assert {"grid.cost-stable", "top.sample-median"} <= keys["README.md"]
+
+
+def test_the_pooled_range_counts_are_the_range_summarys():
+    """Independently of the pooled group: the loops and the loops at rest it reports are
+    the sums over the cells of data/paper_range_rest_summary.parquet (the same finished
+    sweeps, tabulated by scripts/rest_study.py through ``loopsim.summarize``)."""
+    import pandas as pd
+
+    values = RENDER.numbers()
+    summary = pd.read_parquet(os.path.join(ROOT, "data", "paper_range_rest_summary.parquet"))
+    assert values["range.pooled-loops"] == RENDER.count(summary["rest_observed"].sum())
+    assert values["range.pooled-at-rest"] == RENDER.count(summary["at_rest"].sum())
+    left = values["range.pooled-left"]
+    moving = int(summary["rest_observed"].sum() - summary["at_rest"].sum())
+    assert (left == "none") if moving == 0 else left.count("seed") == moving
