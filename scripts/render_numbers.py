@@ -441,6 +441,29 @@ def _range_rest_cost():
             "range.rest-cells60-hours": f"{60 * 8 * walls.mean() / 3600:.0f} h"}
 
 
+def _range_rest_progress():
+    """How far the range sweeps (``data/rest_runs/range_rest_t<theta0>``, one per tilt of
+    the paper's grid) have got: ``range.rest-rows-done`` (the finished tilts) and
+    ``range.rest-rows-pending`` (each unfinished tilt with its runs committed so far, or
+    "none")."""
+    from loopsim import storage
+
+    done, pending = [], []
+    for theta0 in range(6, 91, 6):
+        path = os.path.join(DATA, "rest_runs", f"range_rest_t{theta0}")
+        if not os.path.isdir(path):
+            pending.append(f"{theta0}° (not started)")
+            continue
+        rows = len(table(os.path.relpath(path, DATA)))
+        cases = len(storage.read_sweep_file(path)["config"]["cases"])
+        if rows == cases:
+            done.append(theta0)
+        else:
+            pending.append(f"{theta0}° ({rows} of {cases} runs)")
+    return {"range.rest-rows-done": ", ".join(f"{t}°" for t in done) or "none",
+            "range.rest-rows-pending": ", ".join(pending) or "none"}
+
+
 #: Onsets (t_u) at which the pooled tail's escape rate is estimated: a constant rate
 #: from each onset on is an exponential (memoryless) tail.
 TAIL_ONSETS = (10.0, 15.0, 20.0)
@@ -484,7 +507,7 @@ def _range_rest_pooled():
 #: Groups of keys, each computed together from one table; a key's function is its group's.
 GROUPS = (_n6_counts, _n6_labels, _fig9_counts, _grid_costs, _top_costs, _tumbling_samples, _convergence,
           _rest_window, _rest_study, _range_overview, _range_rest_cost,
-          _range_rest_pooled)
+          _range_rest_pooled, _range_rest_progress)
 
 
 @functools.lru_cache(maxsize=None)

@@ -78,3 +78,5 @@ def test_the_pooled_range_counts_are_the_range_summarys():
     left = values["range.pooled-left"]
     moving = int(summary["rest_observed"].sum() - summary["at_rest"].sum())
     assert (left == "none") if moving == 0 else left.count("seed") == moving
+    done = values["range.rest-rows-done"]
+    assert done == ", ".join(f"{t:.0f}°" for t in sorted(summary["theta0_deg"].unique()))
