@@ -464,6 +464,53 @@ def _range_rest_progress():
             "range.rest-rows-pending": ", ".join(pending) or "none"}
 
 
+def _range_horizon_regimes():
+    """The regime shares at t = 10 against those run to rest, at the cells of the range
+    in both ``data/paper_range_summary.parquet`` (t = 10, ``--seeds auto``, an earlier
+    code) and ``data/paper_range_rest_summary.parquet`` (t_max 40): per cell P(in-plane)
+    and P(3D) each way with the Newcombe interval of P(3D) at t_max minus at t = 10
+    (``range.horizon-table``), and the same differences pooled over the cells whose two
+    samples have the same seeds, with the smallest difference they could detect.  The
+    samples use the same seeds: positively correlated, if anything, so the
+    unpaired intervals are conservative where their starts coincide."""
+    from loopsim import distribution_differences as dd
+
+    ten = pd.read_parquet(os.path.join(DATA, "paper_range_summary.parquet"))
+    rest = pd.read_parquet(os.path.join(DATA, "paper_range_rest_summary.parquet"))
+    both = ten.merge(rest, on=["g0", "theta0_deg"], suffixes=("_10", "_rest"))
+    rows = ["| g0, θ0 | seeds: t = 10 / to rest | P(in-plane): t = 10 / to rest "
+            "| P(3D): t = 10 / to rest | P(3D) to rest − at t = 10 |",
+            "|---|--:|--:|--:|---|"]
+    hits = {}
+    for _, r in both.iterrows():
+        n10, nrest = int(r["seeds_10"]), int(r["seeds_rest"])
+        k10, krest = round(r["p_3d_10"] * n10), round(r["p_3d_rest"] * nrest)
+        low, high = dd.newcombe_interval(k10, n10, krest, nrest)
+        rows.append(f"| ({r['g0']:.1f}, {r['theta0_deg']:.0f}°) | {n10} / {nrest} | "
+                    f"{r['p_in_plane_10']:.2f} / {r['p_in_plane_rest']:.2f} | "
+                    f"{r['p_3d_10']:.2f} / {r['p_3d_rest']:.2f} | "
+                    f"{krest / nrest - k10 / n10:+.2f} [{low:+.2f}, {high:+.2f}] |")
+        if n10 == nrest:
+            for regime in ("in_plane", "3d"):
+                counts = hits.setdefault(regime, [0, 0, 0])
+                counts[0] += round(r[f"p_{regime}_10"] * n10)
+                counts[1] += round(r[f"p_{regime}_rest"] * nrest)
+                counts[2] += n10
+    out = {"range.horizon-cells": count(len(both)),
+           "range.horizon-table": "\n\n" + "\n".join(rows) + "\n\n" if len(both) else "none yet"}
+    for regime in ("in_plane", "3d"):
+        key = f"range.horizon-pooled-{regime.replace('_', '-')}"
+        out[key], out[key + "-detectable"] = "no cell yet", "none"
+    for regime, (k10, krest, trials) in hits.items():
+        key = f"range.horizon-pooled-{regime.replace('_', '-')}"
+        low, high = dd.newcombe_interval(k10, trials, krest, trials)
+        out[key] = (f"{k10} → {krest} of {trials}: {(krest - k10) / trials:+.2f} "
+                    f"[{low:+.2f}, {high:+.2f}]")
+        out[key + "-detectable"] = (
+            f"{dd.detectable_probability_difference(k10 / trials, trials, trials):.2f}")
+    return out
+
+
 #: Onsets (t_u) at which the pooled tail's escape rate is estimated: a constant rate
 #: from each onset on is an exponential (memoryless) tail.
 TAIL_ONSETS = (10.0, 15.0, 20.0)
@@ -507,7 +554,7 @@ def _range_rest_pooled():
 #: Groups of keys, each computed together from one table; a key's function is its group's.
 GROUPS = (_n6_counts, _n6_labels, _fig9_counts, _grid_costs, _top_costs, _tumbling_samples, _convergence,
           _rest_window, _rest_study, _range_overview, _range_rest_cost,
-          _range_rest_pooled, _range_rest_progress)
+          _range_rest_pooled, _range_rest_progress, _range_horizon_regimes)
 
 
 @functools.lru_cache(maxsize=None)

@@ -80,3 +80,25 @@ def test_the_pooled_range_counts_are_the_range_summarys():
     assert (left == "none") if moving == 0 else left.count("seed") == moving
     done = values["range.rest-rows-done"]
     assert done == ", ".join(f"{t:.0f}°" for t in sorted(summary["theta0_deg"].unique()))
+
+
+def test_the_horizon_comparison_pools_only_cells_with_equal_seeds(tmp_path, monkeypatch):
+    """Two cells at t = 10 and to rest: the one with 4 seeds at t = 10 is in the per-cell
+    table but not in the pooled counts; a cell only at t = 10 is in neither."""
+    import pandas as pd
+
+    ten = pd.DataFrame({"g0": [300.0, 300.0, 350.0], "theta0_deg": [6.0, 12.0, 6.0],
+                        "seeds": [4, 8, 8], "p_in_plane": [1.0, 0.25, 0.5],
+                        "p_3d": [0.0, 0.75, 0.5]})
+    rest = pd.DataFrame({"g0": [300.0, 300.0], "theta0_deg": [6.0, 12.0], "seeds": [8, 8],
+                         "p_in_plane": [0.5, 0.0], "p_3d": [0.5, 1.0]})
+    ten.to_parquet(tmp_path / "paper_range_summary.parquet")
+    rest.to_parquet(tmp_path / "paper_range_rest_summary.parquet")
+    monkeypatch.setattr(RENDER, "DATA", str(tmp_path))
+    out = RENDER._range_horizon_regimes()
+    assert out["range.horizon-cells"] == "2"
+    assert out["range.horizon-pooled-3d"].startswith("6 → 8 of 8: +0.25 [")
+    assert out["range.horizon-pooled-in-plane"].startswith("2 → 0 of 8: -0.25 [")
+    table = out["range.horizon-table"]
+    assert "| (300.0, 6°) | 4 / 8 |" in table and "(350.0, 6°)" not in table
+    assert "| 0.75 / 1.00 | +0.25 [" in table
