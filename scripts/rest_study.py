@@ -38,7 +38,8 @@ table never shrinks: the script refuses to overwrite a table with one that lacks
 it holds.  It writes
 the table (columns: ``loopsim.columns.REST_STUDY_COLUMNS``) and two figures:
 ``rest_survival.png`` (the survival curves) and ``rest_tilts.png`` (tilts at rest over
-the window).
+the window), and from the range sweeps ``range_survival.png`` (their loops pooled, with
+the exponential tail after t = 10).
 """
 import argparse
 import json
@@ -139,9 +140,9 @@ RANGE_SEEDS = 8
 RANGE_OUT = os.path.join("data", "paper_range_rest_summary.parquet")
 
 
-def tabulate_range(runs, window):
-    """``loopsim.summarize`` of every finished range sweep in ``runs`` (with the rest
-    window), or None where none has finished."""
+def range_rows(runs):
+    """The rows of every finished range sweep in ``runs``, concatenated, or None where
+    none has finished."""
     frames = []
     for theta0 in RANGE_THETA0:
         path = os.path.join(runs, f"range_rest_t{theta0}")
@@ -154,10 +155,7 @@ def tabulate_range(runs, window):
             print(f"range_rest_t{theta0}: {len(frame)} of {cases} cases, left out")
             continue
         frames.append(frame)
-    if not frames:
-        return None
-    return outcome_statistics.summarize(pd.concat(frames, ignore_index=True),
-                                        rest_window=window)
+    return pd.concat(frames, ignore_index=True) if frames else None
 
 
 def write_range(table, out):
@@ -196,7 +194,7 @@ def main():
                         "the sweeps (a frozen install keeps the study on one code version)")
     parser.add_argument("--out", default=os.path.join("data", "rest_study.parquet"))
     parser.add_argument("--figures", default=os.path.join("docs", "figures"),
-                        help="directory of rest_survival.png and rest_tilts.png")
+                        help="directory of rest_survival.png, rest_tilts.png and range_survival.png")
     parser.add_argument("--read-only", action="store_true",
                         help="run nothing: tabulate the sweeps that have finished")
     parser.add_argument("--range-out", default=RANGE_OUT,
@@ -242,7 +240,9 @@ def main():
         sys.exit("rest_study: no sweep has finished")
     window = rest_window.stability_losses(args.window_n)
     table = tabulate(frames, bases, window)
-    range_table = tabulate_range(args.runs, window)
+    ranged = range_rows(args.runs)
+    range_table = (None if ranged is None
+                   else outcome_statistics.summarize(ranged, rest_window=window))
     refuse_to_shrink(table, args.out, "--out")   # both checked before anything is written
     if range_table is not None:
         refuse_to_shrink(range_table, args.range_out, "--range-out")
@@ -265,6 +265,8 @@ def main():
     figures.save(figures.rest_tilts(rows, window), os.path.join(args.figures, "rest_tilts.png"))
     if range_table is not None:
         write_range(range_table, args.range_out)
+        figures.save(figures.pooled_survival(ranged),
+                     os.path.join(args.figures, "range_survival.png"))
     with pd.option_context("display.width", 220, "display.max_columns", 40):
         shown = ["g0", "theta0_deg", "q0", "seeds", "at_rest", "moving_at_t_max",
                  "p_rest_t10", "t_rest_median", "t_rest_q95", "rest_inside", "rest_below",

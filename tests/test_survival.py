@@ -180,3 +180,26 @@ def test_survival_figure_and_report_section():
     assert list(cells["rest_inside"]) == [2, 2] and list(cells["rest_below"]) == [0, 1]
     html = sweep_report.settling_section(frame, cells)
     assert "<h2>Settling</h2>" in html and "data:image/png" in html
+
+
+def test_pooled_survival_draws_the_exponential_tail_from_the_horizon():
+    """Eight loops over two cells: four rest before t = 10, three after (t = 12, 14, 16),
+    one is censored at 40. Pooled, S(10) = 1/2, S ends at 1/8, and the escape rate after
+    10 is 3 events over 2 + 4 + 6 + 30 = 42 t_u of exposure."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    from loopsim import figures
+
+    frame = pd.concat([cell([2.0, 4.0, 12.0, 40.0], ["steady"] * 3 + ["t_end"], g0=350.0),
+                       cell([6.0, 8.0, 14.0, 16.0], ["steady"] * 4, g0=325.7)],
+                      ignore_index=True)
+    ax = figures.pooled_survival(frame).axes[0]
+    lines = {line.get_label(): line for line in ax.get_lines()}
+    steps = lines["Kaplan–Meier, 7 of 8 at rest"]
+    assert steps.get_ydata()[-1] == pytest.approx(1 / 8)
+    tail = lines["exp. tail, r = 0.07 per t_u (3 events)"]
+    t, s = tail.get_xdata(), tail.get_ydata()
+    assert t[0] == 10.0 and s[0] == pytest.approx(0.5)
+    assert s[-1] == pytest.approx(0.5 * np.exp(-3 / 42 * (t[-1] - 10.0)))
+    assert ax.get_yscale() == "log"

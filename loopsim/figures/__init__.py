@@ -27,7 +27,7 @@ as DataFrames, so every function can be drawn from stored numbers:
   table (``loopsim.summarize``) drawn as distributions;
 * :func:`growth_rates`, :func:`nonlocal_thresholds`, :func:`model_outcomes` - the
   linearisation of the circle, the nonlocal model beside the local one;
-* :func:`survival_curves`, :func:`rest_tilts` - how long loops take to come to rest
+* :func:`survival_curves`, :func:`pooled_survival`, :func:`rest_tilts` - how long loops take to come to rest
   (Kaplan–Meier) and where they rest against the stable branch's tilt window;
   :func:`range_overview` - the paper's range cell by cell, with P(not at rest by t = 10);
 * :func:`trajectory` - one run's snapshots, face-on, with tilt and aspect ratio;
@@ -58,7 +58,7 @@ from .gallery import gallery, plane_view, side_view_basis, unit_circle
 from .linear import branch_lines, growth_rates, load_branch, stability, stability_data
 from .nonlocal_sbt import model_outcomes, nonlocal_thresholds
 from .phase import phase_diagram, phase_diagrams
-from .settling import range_overview, rest_tilts, survival_curves
+from .settling import pooled_survival, range_overview, rest_tilts, survival_curves
 from .style import (
     ASPECT_LABEL, CURVE_POINTS, PAPER_BAND, REGIME_STYLE, TIME_CMAP, centred_curve, coefficients,
     default_thresholds, frame_model, mark_undetermined, merged_legend_entries, model_text,
@@ -83,7 +83,7 @@ __all__ = [
     "range_overview", "regime_key", "regime_pies", "regime_style", "resolved_mask", "rest_tilts",
     "rest_window_curve",
     "rest_window_for", "run_title", "save",
-    "save_distribution_figure", "survival_curves",
+    "pooled_survival", "save_distribution_figure", "survival_curves",
     "scatter_regimes", "seed_distributions", "settling_index", "side_view_basis", "single_axes",
     "snapshot_indices", "stability", "stability_data", "sweep_kind", "sweep_label",
     "tension_figure", "tension_on_shape", "tilt_distribution", "time_colours", "trajectory",
