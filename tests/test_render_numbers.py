@@ -78,6 +78,11 @@ def test_the_pooled_range_counts_are_the_range_summarys():
     left = values["range.pooled-left"]
     moving = int(summary["rest_observed"].sum() - summary["at_rest"].sum())
     assert (left == "none") if moving == 0 else left.count("seed") == moving
+    # README.md and docs/studies/rest.md say none tumbles for good: a loop still moving
+    # at t = 40 is quiet (approaching its rest too slowly for the steady test), never
+    # unsteady
+    rows = pd.concat(RENDER._finished_range_rest_sweeps())
+    assert set(rows.loc[rows["stop_reason"].eq("t_end"), "terminal_state"]) <= {"quiet"}
     done = values["range.rest-rows-done"]
     assert done == ", ".join(f"{t:.0f}°" for t in sorted(summary["theta0_deg"].unique()))
 
