@@ -78,6 +78,23 @@ def cell_groups(frame, by):
     return groups
 
 
+def complete_cells(frame):
+    """{(g0, theta0_deg): rows} of the cells of a sweep's ``frame`` (from
+    ``read_results``) whose every case has finished, the count each needs read from the
+    sweep's case list (``frame.attrs["loopsim"]["sweep_config"]["cases"]``); keys rounded
+    to 6 decimals, so that cells of two sweeps pair up whatever the last bits of g0.
+    ValueError where the frame carries no case list."""
+    try:
+        cases = frame.attrs["loopsim"]["sweep_config"]["cases"]
+    except (KeyError, TypeError):
+        raise ValueError("the table carries no sweep case list (read it with "
+                         "loopsim.read_results)") from None
+    wanted = pd.DataFrame(cases).groupby(["g0", "theta0_deg"]).size()
+    return {(round(float(g0), 6), round(float(theta0), 6)): rows
+            for (g0, theta0), rows in frame.groupby(["g0", "theta0_deg"])
+            if len(rows) == wanted.get((g0, theta0), -1)}
+
+
 def steady_tested(frame):
     """Whether the rows of a results table were tested for a steady state (the early stop
     could end them, so ``stop_reason`` "steady" counts them): False where the table records

@@ -33,6 +33,14 @@ Greenwood ("log-log") band.  Per cell (``settling_statistics``):
   (the upper limit alone says little then; ``escape_events`` and ``tail_time`` still
   say what the tail holds).
 
+Whether the tail is exponential: ``window_escape_rates`` splits it at given times into
+windows (a, b] and takes the same estimate in each (D_w runs at rest in it, E_w =
+Σ max(0, min(T_i, b) − a)); ``one_rate_p_value`` tests one rate across the windows
+by the likelihood ratio G = 2 Σ_w D_w ln(D_w / (E_w λ̂)), λ̂ = ΣD / ΣE, against χ² with
+(windows − 1) degrees of freedom (given ΣD, the counts are multinomial over the windows
+in proportion to E_w: the G-test of that).  A mixture of cells with different rates has
+a falling rate, which this test can detect where the tail holds enough events.
+
 A survival that falls to zero within the runs' horizon is a transient; one that levels
 off at S > 0 with runs censored at a long t_end is a lasting motion (tumbling, or a slow
 approach where the decay rate vanishes, as at the edges of the stable window) or a
@@ -132,6 +140,41 @@ def escape_rate(times, at_rest, onset=PAPER_HORIZON, level=LEVEL):
     low = stats.chi2.ppf(alpha / 2, 2 * events) / (2 * exposure)
     high = stats.chi2.ppf(1 - alpha / 2, 2 * events + 2) / (2 * exposure)
     return events / exposure, float(low), float(high), events, exposure
+
+
+def window_escape_rates(times, at_rest, edges, level=LEVEL):
+    """The escape rate in each window (edges[i], edges[i + 1]] (module docstring): a
+    DataFrame with ``start``, ``end``, ``events``, ``exposure`` (t_u), ``rate`` (per
+    t_u) and its exact Poisson ``low`` and ``high`` (NaN where a window has no exposure;
+    ``low`` 0 where it has no event)."""
+    times, at_rest = np.asarray(times, float), np.asarray(at_rest, bool)
+    alpha, out = 1.0 - level, []
+    for start, end in zip(edges[:-1], edges[1:]):
+        events = int(np.sum(at_rest & (times > start) & (times <= end)))
+        exposure = float(np.sum(np.clip(times, start, end) - start))
+        rate = low = high = math.nan
+        if exposure > 0.0:
+            rate = events / exposure
+            low = stats.chi2.ppf(alpha / 2, 2 * events) / (2 * exposure) if events else 0.0
+            high = stats.chi2.ppf(1 - alpha / 2, 2 * events + 2) / (2 * exposure)
+        out.append(dict(start=float(start), end=float(end), events=events,
+                        exposure=exposure, rate=rate, low=float(low), high=float(high)))
+    return pd.DataFrame(out)
+
+
+def one_rate_p_value(events, exposures):
+    """P-value of one escape rate across windows with ``events`` runs at rest in
+    ``exposures`` t_u each (the likelihood-ratio G-test, module docstring); NaN with
+    fewer than two windows with exposure or no event at all."""
+    events, exposures = np.asarray(events, float), np.asarray(exposures, float)
+    keep = exposures > 0.0
+    events, exposures = events[keep], exposures[keep]
+    if events.size < 2 or events.sum() == 0:
+        return math.nan
+    expected = exposures * events.sum() / exposures.sum()
+    hit = events > 0
+    g = 2.0 * float(np.sum(events[hit] * np.log(events[hit] / expected[hit])))
+    return float(stats.chi2.sf(g, events.size - 1))
 
 
 def settling_statistics(frame, horizon=PAPER_HORIZON, level=LEVEL):

@@ -64,10 +64,10 @@ work_precision (docs/studies/performance.md) runs ``benchmarks/bench_trajectory.
 runs ``scripts/paper_range_study.py``, which also writes its tables into data/;
 paper_range_top redraws the top of that range from the sweeps committed under
 data/paper_range_runs (``paper_range_study.py --top --read-only``: the parts themselves
-take hours each and run apart, see docs/studies/paper-range.md); rest_survival,
-rest_tilts and range_survival redraw the run-to-rest study from data/rest_runs (``rest_study.py
---read-only``, docs/studies/rest.md); paper_range_overview draws the whole range from the
-committed tables (``range_overview.py``).  Fig. 3 and
+take hours each and run apart, see docs/studies/paper-range.md); rest_survival and
+rest_tilts redraw the run-to-rest study from data/rest_runs (``rest_study.py
+--read-only``, docs/studies/rest.md); paper_range_overview and range_survival draw the
+whole range from the committed tables and sweeps (``range_overview.py``).  Fig. 3 and
 nonlocal_thresholds (the circle's critical q against ε) need no run.  Nothing
 here is random beyond the seeded initial perturbations
 (seed 0 unless stated), so a rerun reproduces the tables.
@@ -260,8 +260,8 @@ def targets(quick=False):
         "paper_range_top": ([], ("study_top",)),
         "rest_survival": ([], ("rest_study",)),
         "rest_tilts": ([], ("rest_study",)),
-        "range_survival": ([], ("rest_study",)),
         "paper_range_overview": ([], ("range_overview",)),
+        "range_survival": ([], ("range_overview",)),
         "seed_distributions": (["seeds_n6", "seeds_auto"],
                                ("figures", "seeds_n6", ["seeds_n6", "seeds_auto"], "seeds",
                                 "seed_distributions")),

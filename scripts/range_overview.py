@@ -3,7 +3,7 @@ study that answers it best (issue 53, item 4).
 
 Usage: python scripts/range_overview.py [--data data] [--out data/paper_range_overview.parquet]
                                         [--figure docs/figures/paper_range_overview.png]
-                                        [--window-n 16]
+                                        [--survival-figure PATH] [--window-n 16]
 
 Runs nothing: it reads the committed tables and sweeps under ``--data``, in this order of
 precedence:
@@ -26,9 +26,11 @@ source has it, else 1 - steady / (seeds - failed) with its Wilson interval (the 
 test is what "at rest" means).
 
 Writes ``--out`` (columns: ``loopsim.columns.RANGE_OVERVIEW_COLUMNS``, each described;
-225 rows, one per cell) and ``--figure`` (``loopsim.figures.range_overview``: the regime
+225 rows, one per cell), ``--figure`` (``loopsim.figures.range_overview``: the regime
 probabilities and P(not at rest by t = 10) per cell, the thresholds and the stable
-branch's upper edge).  It refuses (exit status 2, nothing written) where ``--out`` holds
+branch's upper edge) and ``--survival-figure`` (``loopsim.figures.pooled_survival``:
+every loop of the cells run to rest, the samples the table takes, pooled into one
+Kaplan–Meier survival with the exponential tail after t = 10).  It refuses (exit status 2, nothing written) where ``--out`` holds
 another kind of table, or an overview that knows a cell this run would not.
 """
 import argparse
@@ -51,6 +53,8 @@ from loopsim.survival import PAPER_HORIZON
 #: The paper's grid: g0 = 10..350 in 15 values, θ0 = 6..90° in 15.
 G0 = np.linspace(10.0, 350.0, 15)
 THETA0 = np.linspace(6.0, 90.0, 15)
+#: The pooled survival figure's name, beside ``--figure`` unless given.
+SURVIVAL_FIGURE = "range_survival.png"
 #: The t = 10 tables, the first that holds a cell answering it.
 HORIZON_TABLES = ("paper_range_top_summary.parquet", "paper_range_summary.parquet")
 CELL = ("g0", "theta0_deg")
@@ -63,22 +67,12 @@ def cell_key(g0, theta0):
 
 def finished_cells(path):
     """{cell key: rows} of the cells of the sweep at ``path`` whose every case has finished
-    (the sweep's case list, in its ``_sweep.json``, says how many each has); none for a
-    folder that is not (yet) a sweep."""
+    (``outcome_statistics.complete_cells``); none for a folder that is not (yet) a sweep."""
     try:
-        frame = loopsim.read_results(path)
-        record = storage.read_sweep_file(path)
+        return outcome_statistics.complete_cells(loopsim.read_results(path))
     except (FileNotFoundError, ValueError) as exc:
         print(f"{path}: left out ({exc})", file=sys.stderr)
         return {}
-    if record is None:
-        return {}
-    wanted = pd.DataFrame(record["config"]["cases"]).groupby(list(CELL)).size()
-    out = {}
-    for (g0, theta0), rows in frame.groupby(list(CELL)):
-        if len(rows) == wanted.get((g0, theta0), -1):
-            out[cell_key(g0, theta0)] = rows
-    return out
 
 
 def summarised(cells, window):
@@ -88,8 +82,8 @@ def summarised(cells, window):
             for key, (source, rows) in cells.items()}
 
 
-def rest_cells(data, window):
-    """The cells run to rest, the largest sample of each."""
+def rest_samples(data):
+    """{cell key: (source, rows)} of the cells run to rest, the largest sample of each."""
     best = {}
     for path in sorted(glob.glob(os.path.join(data, "rest_runs", "*rest_t*"))):
         if not os.path.isdir(path):
@@ -97,7 +91,7 @@ def rest_cells(data, window):
         for key, rows in finished_cells(path).items():
             if key not in best or len(rows) > len(best[key][1]):
                 best[key] = (os.path.relpath(path, os.path.dirname(data)), rows)
-    return summarised(best, window)
+    return best
 
 
 def horizon_cells(data):
@@ -158,11 +152,12 @@ def overview_row(row, source, t_max):
     return out
 
 
-def overview(data, window):
-    """The 225-row table: each cell from the run-to-rest sweeps, else the t = 10 tables,
-    else the unfinished t = 10 parts, else empty."""
+def overview(data, window, rested):
+    """The 225-row table: each cell from the run-to-rest samples ``rested``
+    (:func:`rest_samples`), else the t = 10 tables, else the unfinished t = 10 parts,
+    else empty."""
     found = {**unfinished_part_cells(data, window), **horizon_cells(data),
-             **rest_cells(data, window)}   # later sources win
+             **summarised(rested, window)}   # later sources win
     rows = []
     for theta0 in THETA0:
         for g0 in G0:
@@ -201,11 +196,13 @@ def tabulate(args):
     args.data = os.path.normpath(args.data)   # "data/" names its sources as "data" does
     validation.check_output_file("--out", args.out)
     validation.check_output_file("--figure", args.figure)
+    validation.check_output_file("--survival-figure", args.survival_figure)
     if not any(os.path.exists(os.path.join(args.data, name))
                for name in (*HORIZON_TABLES, "rest_runs")):
         raise ValueError(f"no committed table or rest_runs folder under --data {args.data!r}")
     window = rest_window.stability_losses(args.window_n)
-    table = overview(args.data, window)
+    rested = rest_samples(args.data)
+    table = overview(args.data, window, rested)
     known = table[table["seeds"] > 0]
     held = known_cells(args.out)
     lost = held - storage.study_keys(known, CELL)
@@ -216,7 +213,9 @@ def tabulate(args):
                          "give another --out")
     meta = dict(sources=sorted(set(known["source"])), window=window.as_dict(),
                 intervals="95% Wilson or Kaplan-Meier log-log", loopsim_version=loopsim.__version__)
-    return table, window, meta
+    pooled = pd.concat([rows for _, rows in rested.values()], ignore_index=True) \
+        if rested else None
+    return table, window, meta, pooled
 
 
 def main(argv=None):
@@ -227,9 +226,14 @@ def main(argv=None):
                         default=os.path.join("docs", "figures", "paper_range_overview.png"))
     parser.add_argument("--window-n", type=int, default=rest_window.DEFAULT_WINDOW_N,
                         help="truncation order of the steady branch whose window is used")
+    parser.add_argument("--survival-figure", default=None,
+                        help="the pooled survival of every loop run to rest (default: "
+                        "range_survival.png beside --figure)")
     args = parser.parse_args(argv)
+    if args.survival_figure is None:
+        args.survival_figure = os.path.join(os.path.dirname(args.figure), SURVIVAL_FIGURE)
     try:
-        table, window, meta = tabulate(args)
+        table, window, meta, pooled = tabulate(args)
     except ValueError as exc:
         print(f"range_overview: error: {exc}", file=sys.stderr)
         sys.exit(2)
@@ -239,17 +243,21 @@ def main(argv=None):
     from loopsim import figures
 
     figure = figures.range_overview(table, window)   # drawn before anything is written
+    survival = figures.pooled_survival(pooled) if pooled is not None else None
     arrow = pa.Table.from_pandas(table, preserve_index=False)
     arrow = arrow.replace_schema_metadata(storage.provenance(
         loopsim_range_overview=json.dumps(meta)))
     storage.write_table_atomically(storage.described(arrow, columns.RANGE_OVERVIEW_COLUMNS),
                                    args.out)
     figures.save(figure, args.figure, dpi=150)
+    if survival is not None:
+        figures.save(survival, args.survival_figure)
     known = table[table["seeds"] > 0]
     by_source = known.groupby("t_max").size()
     print(f"wrote {args.out}: {len(known)} of {len(table)} cells known "
           + ", ".join(f"{n} at t_max = {t:g}" for t, n in by_source.items())
-          + f"; figure {args.figure}")
+          + f"; figures {args.figure}"
+          + (f", {args.survival_figure}" if survival is not None else ""))
 
 
 if __name__ == "__main__":

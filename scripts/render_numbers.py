@@ -412,29 +412,36 @@ def _range_overview():
             "range.top-table": "\n\n" + "\n".join(rows) + "\n\n"}
 
 
-def _finished_range_rest_sweeps():
-    """The rows of every finished ``data/rest_runs/range_rest_t*`` sweep, one frame each
-    (a sweep still running has its slow cases still to come, so it is left out)."""
-    from loopsim import storage
+#: The paper's grid of initial tilts (deg): one range sweep per tilt.
+RANGE_THETA0 = tuple(range(6, 91, 6))
 
-    frames = []
-    for path in sorted(glob.glob(os.path.join(DATA, "rest_runs", "range_rest_t*"))):
-        rows = table(os.path.relpath(path, DATA))
-        if len(rows) and len(rows) == len(storage.read_sweep_file(path)["config"]["cases"]):
-            frames.append(rows)
-    return frames
+
+def _range_sweeps():
+    """{theta0: rows} of the range sweeps under ``data/rest_runs`` (``range_rest_t<θ0>``,
+    one per tilt of :data:`RANGE_THETA0`, run to rest), those started so far."""
+    found = {}
+    for theta0 in RANGE_THETA0:
+        name = os.path.join("rest_runs", f"range_rest_t{theta0}")
+        if os.path.isdir(os.path.join(DATA, name)):
+            found[theta0] = table(name)
+    return found
+
+
+def _finished(rows):
+    """Whether every case of a sweep's rows (from ``read_results``) has finished."""
+    return len(rows) == len(rows.attrs["loopsim"]["sweep_config"]["cases"])
 
 
 def _range_rest_cost():
     """What a loop run to rest costs at the top of the range: ``wall_s`` of the finished
-    range sweeps' rows (2 shared cores)."""
-    frames = _finished_range_rest_sweeps()
+    range sweeps' rows (2 shared cores; a sweep still running has its slow cases still
+    to come, so it is left out)."""
+    frames = {t: rows for t, rows in _range_sweeps().items() if _finished(rows)}
     if not frames:
         return {}
-    walls = pd.concat(frames)["wall_s"].to_numpy(float)
-    tilts = [int(rows["theta0_deg"].iloc[0]) for rows in frames]
+    walls = pd.concat(frames.values())["wall_s"].to_numpy(float)
     return {"range.rest-runs": count(walls.size),
-            "range.rest-tilts": f"{min(tilts)}–{max(tilts)}°",
+            "range.rest-tilts": f"{min(frames)}–{max(frames)}°",
             "range.rest-sample-median": f"{np.median(walls):.0f} s",
             "range.rest-sample-span": f"{walls.min():.1f}–{walls.max():.0f} s",
             "range.rest-cell-hours": f"{8 * walls.mean() / 3600:.2f} h",
@@ -442,67 +449,69 @@ def _range_rest_cost():
 
 
 def _range_rest_progress():
-    """How far the range sweeps (``data/rest_runs/range_rest_t<theta0>``, one per tilt of
-    the paper's grid) have got: ``range.rest-rows-done`` (the finished tilts) and
-    ``range.rest-rows-pending`` (each unfinished tilt with its runs committed so far, or
-    "none")."""
-    from loopsim import storage
-
-    done, pending = [], []
-    for theta0 in range(6, 91, 6):
-        path = os.path.join(DATA, "rest_runs", f"range_rest_t{theta0}")
-        if not os.path.isdir(path):
-            pending.append(f"{theta0}° (not started)")
-            continue
-        rows = len(table(os.path.relpath(path, DATA)))
-        cases = len(storage.read_sweep_file(path)["config"]["cases"])
-        if rows == cases:
-            done.append(theta0)
-        else:
-            pending.append(f"{theta0}° ({rows} of {cases} runs)")
+    """How far the range sweeps have got: ``range.rest-rows-done`` (the finished tilts)
+    and ``range.rest-rows-pending`` (each unfinished tilt with its runs committed so
+    far, or "none")."""
+    sweeps = _range_sweeps()
+    done = [t for t, rows in sweeps.items() if _finished(rows)]
+    pending = [f"{t}° (not started)" if t not in sweeps else
+               f"{t}° ({len(sweeps[t])} of "
+               f"{len(sweeps[t].attrs['loopsim']['sweep_config']['cases'])} runs)"
+               for t in RANGE_THETA0 if t not in done]
     return {"range.rest-rows-done": ", ".join(f"{t}°" for t in done) or "none",
             "range.rest-rows-pending": ", ".join(pending) or "none"}
 
 
+def _counts(share, trials):
+    """The whole count behind a share of ``trials`` (a summary stores shares)."""
+    hits = share * trials
+    assert abs(hits - round(hits)) < 1e-9, (share, trials)
+    return int(round(hits))
+
+
 def _range_horizon_regimes():
-    """The regime shares at t = 10 against those run to rest, at the cells of the range
-    in both ``data/paper_range_summary.parquet`` (t = 10, ``--seeds auto``, an earlier
-    code) and ``data/paper_range_rest_summary.parquet`` (t_max 40): per cell P(in-plane)
-    and P(3D) each way with the Newcombe interval of P(3D) at t_max minus at t = 10
-    (``range.horizon-table``), and the same differences pooled over the cells whose two
-    samples have the same seeds, with the smallest difference they could detect.  The
-    samples use the same seeds: positively correlated, if anything, so the
-    unpaired intervals are conservative where their starts coincide."""
+    """The regime shares at t = 10 against those run to rest, at the cells in both
+    ``data/paper_range_summary.parquet`` (t = 10, ``--seeds auto``, an earlier code) and
+    ``data/paper_range_rest_summary.parquet`` (run to rest): per cell P(in-plane) and
+    P(3D) each way with the Newcombe interval of P(3D) run to rest minus at t = 10
+    (``range.t10-vs-rest-table``), and the differences pooled over the cells whose two
+    samples have the same number of seeds (seeds 0 to K − 1 both), with the smallest
+    difference they could detect.  Pooling can hide opposite changes in two cells; the
+    table shows each.  Where the two samples' starts coincide they are positively
+    correlated, and the unpaired intervals are then conservative."""
     from loopsim import distribution_differences as dd
 
-    ten = pd.read_parquet(os.path.join(DATA, "paper_range_summary.parquet"))
-    rest = pd.read_parquet(os.path.join(DATA, "paper_range_rest_summary.parquet"))
+    def keyed(frame):
+        return frame.assign(g0=frame["g0"].round(6), theta0_deg=frame["theta0_deg"].round(6))
+
+    ten = keyed(pd.read_parquet(os.path.join(DATA, "paper_range_summary.parquet")))
+    rest = keyed(pd.read_parquet(os.path.join(DATA, "paper_range_rest_summary.parquet")))
     both = ten.merge(rest, on=["g0", "theta0_deg"], suffixes=("_10", "_rest"))
     rows = ["| g0, θ0 | seeds: t = 10 / to rest | P(in-plane): t = 10 / to rest "
             "| P(3D): t = 10 / to rest | P(3D) to rest − at t = 10 |",
             "|---|--:|--:|--:|---|"]
-    hits = {}
+    pooled = {regime: [0, 0, 0] for regime in ("in_plane", "3d")}
     for _, r in both.iterrows():
         n10, nrest = int(r["seeds_10"]), int(r["seeds_rest"])
-        k10, krest = round(r["p_3d_10"] * n10), round(r["p_3d_rest"] * nrest)
+        k10, krest = _counts(r["p_3d_10"], n10), _counts(r["p_3d_rest"], nrest)
         low, high = dd.newcombe_interval(k10, n10, krest, nrest)
         rows.append(f"| ({r['g0']:.1f}, {r['theta0_deg']:.0f}°) | {n10} / {nrest} | "
                     f"{r['p_in_plane_10']:.2f} / {r['p_in_plane_rest']:.2f} | "
                     f"{r['p_3d_10']:.2f} / {r['p_3d_rest']:.2f} | "
                     f"{krest / nrest - k10 / n10:+.2f} [{low:+.2f}, {high:+.2f}] |")
         if n10 == nrest:
-            for regime in ("in_plane", "3d"):
-                counts = hits.setdefault(regime, [0, 0, 0])
-                counts[0] += round(r[f"p_{regime}_10"] * n10)
-                counts[1] += round(r[f"p_{regime}_rest"] * nrest)
-                counts[2] += n10
-    out = {"range.horizon-cells": count(len(both)),
-           "range.horizon-table": "\n\n" + "\n".join(rows) + "\n\n" if len(both) else "none yet"}
-    for regime in ("in_plane", "3d"):
-        key = f"range.horizon-pooled-{regime.replace('_', '-')}"
-        out[key], out[key + "-detectable"] = "no cell yet", "none"
-    for regime, (k10, krest, trials) in hits.items():
-        key = f"range.horizon-pooled-{regime.replace('_', '-')}"
+            for regime, sums in pooled.items():
+                sums[0] += _counts(r[f"p_{regime}_10"], n10)
+                sums[1] += _counts(r[f"p_{regime}_rest"], nrest)
+                sums[2] += n10
+    out = {"range.t10-vs-rest-cells": count(len(both)),
+           "range.t10-vs-rest-table": ("\n\n" + "\n".join(rows) + "\n\n") if len(both)
+           else "none yet"}
+    for regime, (k10, krest, trials) in pooled.items():
+        key = f"range.t10-vs-rest-{regime.replace('_', '-')}"
+        if not trials:
+            out[key], out[key + "-detectable"] = "no cell yet", "none"
+            continue
         low, high = dd.newcombe_interval(k10, trials, krest, trials)
         out[key] = (f"{k10} → {krest} of {trials}: {(krest - k10) / trials:+.2f} "
                     f"[{low:+.2f}, {high:+.2f}]")
@@ -511,43 +520,70 @@ def _range_horizon_regimes():
     return out
 
 
-#: Onsets (t_u) at which the pooled tail's escape rate is estimated: a constant rate
-#: from each onset on is an exponential (memoryless) tail.
-TAIL_ONSETS = (10.0, 15.0, 20.0)
+def _rest_samples():
+    """The rows of every cell run to rest, each from the sweep the range overview
+    (``data/paper_range_overview.parquet``) takes it from: its largest complete sample."""
+    from loopsim import outcome_statistics
+
+    overview = pd.read_parquet(os.path.join(DATA, "paper_range_overview.parquet"))
+    cells, sweeps = [], {}
+    for _, cell in overview[overview["t_max"] > 10].iterrows():
+        source = os.path.relpath(cell["source"], "data")
+        if source not in sweeps:
+            sweeps[source] = outcome_statistics.complete_cells(table(source))
+        cells.append(sweeps[source][(round(cell["g0"], 6), round(cell["theta0_deg"], 6))])
+    return pd.concat(cells, ignore_index=True) if cells else None
+
+
+#: Edges (t_u) of the windows after t = 10 in which the pooled escape rate is estimated
+#: apart: one rate in all of them is an exponential (memoryless) tail.
+TAIL_WINDOWS = (10.0, 15.0, 20.0, 40.0)
 
 
 def _range_rest_pooled():
-    """Every loop of the finished range sweeps pooled (``range.pooled-*``): how many came
-    to rest by t_max (and those that did not, with their ``terminal_state``), P(at rest
-    by t = 10), the time by which 95 % rest, the latest
-    settling time, and the escape rate after each of :data:`TAIL_ONSETS`, with the
-    share of the loops moving at t = 10 that such a tail leaves moving at t_max."""
+    """Every loop of the cells run to rest pooled (``range.pooled-*``): how many came to
+    rest by t_max (and those that did not, with their ``terminal_state``), P(at rest by
+    t = 10), the time by which 95 % rest, the latest settling time, the escape rate after
+    t = 10 and in each window of :data:`TAIL_WINDOWS` with the p-value of one rate across
+    them, and the most a tail at the rate's lower limit leaves moving at t_max of the
+    loops moving at t = 10."""
     from loopsim import survival
 
-    frames = _finished_range_rest_sweeps()
-    if not frames:
+    rows = _rest_samples()
+    if rows is None:
         return {}
-    rows = pd.concat(frames, ignore_index=True)
     pooled = survival.settling_statistics(rows)
     times, at_rest = survival.settling_times(rows)
     t_max = float(rows["t_end"].max())
+    cells = rows.groupby(["g0", "theta0_deg"]).ngroups
     out = {"range.pooled-loops": count(pooled["rest_observed"]),
+           "range.pooled-cells": count(cells),
            "range.pooled-at-rest": count(pooled["at_rest"]),
            "range.pooled-p10": _interval(pooled["p_rest_t10"], pooled["p_rest_t10_low"],
                                          pooled["p_rest_t10_high"], 2),
-           "range.pooled-q95": f"{pooled['t_rest_q95']:.1f}",
-           "range.pooled-latest": f"{times[at_rest].max():.1f}",
+           "range.pooled-q95": (f"{pooled['t_rest_q95']:.1f}"
+                                if np.isfinite(pooled["t_rest_q95"]) else "not reached"),
+           "range.pooled-latest": (f"{times[at_rest].max():.1f}" if at_rest.any()
+                                   else "none at rest"),
            "range.pooled-t-max": f"{t_max:g}"}
-    for onset in TAIL_ONSETS:
-        rate, low, high, events, _ = survival.escape_rate(times, at_rest, onset)
-        out[f"range.pooled-escape-{onset:g}"] = (
-            f"{_interval(rate, low, high, 2)} ({events} events)")
+    rate, low, high, events, _ = survival.escape_rate(times, at_rest)
+    out["range.pooled-escape"] = (f"{_interval(rate, low, high, 2)} ({events} events)"
+                                  if np.isfinite(rate) else f"{events} events: too few")
+    windows = survival.window_escape_rates(times, at_rest, TAIL_WINDOWS)
+    out["range.pooled-escape-windows"] = "; ".join(
+        f"({w.start:g}, {w.end:g}]: {_interval(w.rate, w.low, w.high, 2)} ({w.events} events)"
+        for w in windows.itertuples())
+    p_value = survival.one_rate_p_value(windows["events"], windows["exposure"])
+    out["range.pooled-one-rate-p"] = f"{p_value:.2f}"
+    out["range.pooled-one-rate"] = ("one rate fits" if p_value >= 0.05 else
+                                    "the rate changes") if np.isfinite(p_value) else "untested"
+    out["range.pooled-tail-left"] = (
+        f"{np.exp(-low * (t_max - survival.PAPER_HORIZON)):.1g}" if np.isfinite(low)
+        else "unknown")
     moving = rows[rows["stop_reason"].eq("t_end")]
     out["range.pooled-left"] = "; ".join(
         f"({r['g0']:.1f}, {r['theta0_deg']:.0f}°) seed {r['seed']}, {r['terminal_state']}"
         for _, r in moving.iterrows()) or "none"
-    rate = survival.escape_rate(times, at_rest)[0]
-    out["range.pooled-tail-left"] = f"{np.exp(-rate * (t_max - survival.PAPER_HORIZON)):.0e}"
     return out
 
 
@@ -562,7 +598,10 @@ def numbers():
     """{key: the value's text} for every key of every group."""
     values = {}
     for group in GROUPS:
-        values.update(group())
+        found = group()
+        clash = values.keys() & found.keys()
+        assert not clash, f"{group.__name__} redefines {sorted(clash)}"
+        values.update(found)
     return values
 
 

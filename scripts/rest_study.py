@@ -38,8 +38,7 @@ table never shrinks: the script refuses to overwrite a table with one that lacks
 it holds.  It writes
 the table (columns: ``loopsim.columns.REST_STUDY_COLUMNS``) and two figures:
 ``rest_survival.png`` (the survival curves) and ``rest_tilts.png`` (tilts at rest over
-the window), and from the range sweeps ``range_survival.png`` (their loops pooled, with
-the exponential tail after t = 10).
+the window).
 """
 import argparse
 import json
@@ -194,7 +193,7 @@ def main():
                         "the sweeps (a frozen install keeps the study on one code version)")
     parser.add_argument("--out", default=os.path.join("data", "rest_study.parquet"))
     parser.add_argument("--figures", default=os.path.join("docs", "figures"),
-                        help="directory of rest_survival.png, rest_tilts.png and range_survival.png")
+                        help="directory of rest_survival.png and rest_tilts.png")
     parser.add_argument("--read-only", action="store_true",
                         help="run nothing: tabulate the sweeps that have finished")
     parser.add_argument("--range-out", default=RANGE_OUT,
@@ -265,8 +264,6 @@ def main():
     figures.save(figures.rest_tilts(rows, window), os.path.join(args.figures, "rest_tilts.png"))
     if range_table is not None:
         write_range(range_table, args.range_out)
-        figures.save(figures.pooled_survival(ranged),
-                     os.path.join(args.figures, "range_survival.png"))
     with pd.option_context("display.width", 220, "display.max_columns", 40):
         shown = ["g0", "theta0_deg", "q0", "seeds", "at_rest", "moving_at_t_max",
                  "p_rest_t10", "t_rest_median", "t_rest_q95", "rest_inside", "rest_below",

@@ -384,3 +384,29 @@ def test_determined_is_unknown_where_no_row_ran_a_twin(tmp_path, capsys):
     assert (mixed["seeds"].iloc[0], mixed["twinned"].iloc[0], mixed["determined"].iloc[0]) == (4, 2, 2)
     labels = figures.probability_phase_diagram(mixed).axes[0].get_legend_handles_labels()[1]
     assert "some seeds not determined" not in labels
+
+
+def test_complete_cells_keeps_the_cells_whose_every_case_finished():
+    """The committed partial sweep data/rest_runs/range_rest_t84 against its case list
+    counted by hand: a cell is complete when its rows are as many as its cases."""
+    import os
+
+    path = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                        "data", "rest_runs", "range_rest_t84")
+    frame = loopsim.read_results(path)
+    with open(os.path.join(path, "_sweep.json"), encoding="utf-8") as handle:
+        cases = json.load(handle)["config"]["cases"]
+    wanted = {}
+    for case in cases:
+        key = (round(case["g0"], 6), round(case["theta0_deg"], 6))
+        wanted[key] = wanted.get(key, 0) + 1
+    have = frame.groupby(["g0", "theta0_deg"]).size()
+    expected = {(round(g, 6), round(t, 6)) for (g, t), k in have.items()
+                if k == wanted[(round(g, 6), round(t, 6))]}
+    cells = outcome_statistics.complete_cells(frame)
+    assert set(cells) == expected
+    assert all(len(rows) == wanted[key] for key, rows in cells.items())
+    bare = frame.copy()
+    bare.attrs = {}
+    with pytest.raises(ValueError, match="no sweep case list"):
+        outcome_statistics.complete_cells(bare)

@@ -51,6 +51,8 @@ def test_every_cell_once_with_declared_columns(overview):
     fields = pq.read_schema(overview["out"])
     assert all(fields.field(c).metadata[b"unit"] for c in table.columns)
     assert overview["figure"].stat().st_size > 0
+    # the pooled survival of the cells run to rest, beside the figure unless given
+    assert (overview["figure"].parent / "range_survival.png").stat().st_size > 0
     known = table[table["seeds"] > 0]
     assert set(known["t_max"]) <= {10.0, 40.0}
     assert ((known["p_not_rest_t10_low"] <= known["p_not_rest_t10"])
@@ -101,6 +103,7 @@ def test_refuses_to_forget_a_known_cell(overview, tmp_path):
     done = run(out, tmp_path / "figure.png")
     assert done.returncode == 2 and "knows" in done.stderr and len(done.stderr.splitlines()) == 1
     assert pd.read_parquet(out)["seeds"].loc[gone] == 8 and not (tmp_path / "figure.png").exists()
+    assert not (tmp_path / "range_survival.png").exists()
 
 
 def test_refuses_to_write_over_another_kind_of_table(tmp_path):

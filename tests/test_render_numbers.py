@@ -6,6 +6,8 @@ import importlib.util
 import os
 import re
 
+import pytest
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
 
@@ -65,45 +67,75 @@ def test_the_pages_mark_what_they_quote_from_the_tables():
     assert {"grid.cost-stable", "top.sample-median"} <= keys["README.md"]
 
 
-def test_the_pooled_range_counts_are_the_range_summarys():
-    """Independently of the pooled group: the loops and the loops at rest it reports are
-    the sums over the cells of data/paper_range_rest_summary.parquet (the same finished
-    sweeps, tabulated by scripts/rest_study.py through ``loopsim.summarize``)."""
+def test_the_pooled_counts_are_the_overviews():
+    """Independently of the pooled group: its loops and loops at rest are the sums over
+    the cells the range overview (data/paper_range_overview.parquet) has run to rest, and
+    its cells split the overview's known cells with those at t = 10."""
     import pandas as pd
 
     values = RENDER.numbers()
-    summary = pd.read_parquet(os.path.join(ROOT, "data", "paper_range_rest_summary.parquet"))
-    assert values["range.pooled-loops"] == RENDER.count(summary["rest_observed"].sum())
-    assert values["range.pooled-at-rest"] == RENDER.count(summary["at_rest"].sum())
+    overview = pd.read_parquet(os.path.join(ROOT, "data", "paper_range_overview.parquet"))
+    rest = overview[overview["t_max"] > 10]
+    observed = (rest["seeds"] - (rest["p_failed"] * rest["seeds"]).round()).sum()
+    assert values["range.pooled-loops"] == RENDER.count(observed)
+    assert values["range.pooled-at-rest"] == RENDER.count(rest["at_rest"].sum())
+    assert values["range.pooled-cells"] == values["range.rest-cells"] == RENDER.count(len(rest))
+    assert int(values["range.known"]) == (int(values["range.rest-cells"])
+                                          + int(values["range.horizon-cells"]))
     left = values["range.pooled-left"]
-    moving = int(summary["rest_observed"].sum() - summary["at_rest"].sum())
+    moving = int(observed - rest["at_rest"].sum())
     assert (left == "none") if moving == 0 else left.count("seed") == moving
-    # README.md and docs/studies/rest.md say none tumbles for good: a loop still moving
-    # at t = 40 is quiet (approaching its rest too slowly for the steady test), never
-    # unsteady
-    rows = pd.concat(RENDER._finished_range_rest_sweeps())
+
+
+def test_no_loop_run_to_rest_tumbles_at_its_end():
+    """README.md and docs/studies/rest.md say none tumbles for good: a loop still moving
+    at t = 40 is quiet (approaching its rest too slowly for the steady test), never
+    unsteady."""
+    rows = RENDER._rest_samples()
     assert set(rows.loc[rows["stop_reason"].eq("t_end"), "terminal_state"]) <= {"quiet"}
-    done = values["range.rest-rows-done"]
+
+
+def test_the_range_progress_is_the_range_summarys():
+    import pandas as pd
+
+    summary = pd.read_parquet(os.path.join(ROOT, "data", "paper_range_rest_summary.parquet"))
+    done = RENDER.numbers()["range.rest-rows-done"]
     assert done == ", ".join(f"{t:.0f}°" for t in sorted(summary["theta0_deg"].unique()))
 
 
+def test_a_key_defined_twice_is_refused(monkeypatch):
+    monkeypatch.setattr(RENDER, "GROUPS", (lambda: {"a": "1"}, lambda: {"a": "2"}))
+    RENDER.numbers.cache_clear()
+    try:
+        with pytest.raises(AssertionError, match="redefines"):
+            RENDER.numbers()
+    finally:
+        RENDER.numbers.cache_clear()
+
+
 def test_the_horizon_comparison_pools_only_cells_with_equal_seeds(tmp_path, monkeypatch):
-    """Two cells at t = 10 and to rest: the one with 4 seeds at t = 10 is in the per-cell
-    table but not in the pooled counts; a cell only at t = 10 is in neither."""
+    """Three cells at t = 10 and to rest: the one with 4 seeds at t = 10 is in the per-cell
+    table but not in the pooled counts; a cell only at t = 10 is in neither; the pooled
+    interval is Newcombe's of the summed counts; g0 pairs up whatever its last bits."""
+    from loopsim import distribution_differences as dd
     import pandas as pd
 
-    ten = pd.DataFrame({"g0": [300.0, 300.0, 350.0], "theta0_deg": [6.0, 12.0, 6.0],
-                        "seeds": [4, 8, 8], "p_in_plane": [1.0, 0.25, 0.5],
-                        "p_3d": [0.0, 0.75, 0.5]})
-    rest = pd.DataFrame({"g0": [300.0, 300.0], "theta0_deg": [6.0, 12.0], "seeds": [8, 8],
-                         "p_in_plane": [0.5, 0.0], "p_3d": [0.5, 1.0]})
+    ten = pd.DataFrame({"g0": [300.0, 300.0, 350.0, 325.7142857142857],
+                        "theta0_deg": [6.0, 12.0, 6.0, 12.0], "seeds": [4, 8, 8, 8],
+                        "p_in_plane": [1.0, 0.25, 0.5, 0.5], "p_3d": [0.0, 0.75, 0.5, 0.5]})
+    rest = pd.DataFrame({"g0": [300.0, 300.0, 325.71428571428567],
+                         "theta0_deg": [6.0, 12.0, 12.0], "seeds": [8, 8, 8],
+                         "p_in_plane": [0.5, 0.0, 0.375], "p_3d": [0.5, 1.0, 0.625]})
     ten.to_parquet(tmp_path / "paper_range_summary.parquet")
     rest.to_parquet(tmp_path / "paper_range_rest_summary.parquet")
     monkeypatch.setattr(RENDER, "DATA", str(tmp_path))
     out = RENDER._range_horizon_regimes()
-    assert out["range.horizon-cells"] == "2"
-    assert out["range.horizon-pooled-3d"].startswith("6 → 8 of 8: +0.25 [")
-    assert out["range.horizon-pooled-in-plane"].startswith("2 → 0 of 8: -0.25 [")
-    table = out["range.horizon-table"]
+    assert out["range.t10-vs-rest-cells"] == "3"
+    low, high = dd.newcombe_interval(10, 16, 13, 16)
+    assert out["range.t10-vs-rest-3d"] == f"10 → 13 of 16: +0.19 [{low:+.2f}, {high:+.2f}]"
+    assert out["range.t10-vs-rest-in-plane"].startswith("6 → 3 of 16: -0.19 [")
+    assert out["range.t10-vs-rest-3d-detectable"] == (
+        f"{dd.detectable_probability_difference(10 / 16, 16, 16):.2f}")
+    table = out["range.t10-vs-rest-table"]
     assert "| (300.0, 6°) | 4 / 8 |" in table and "(350.0, 6°)" not in table
     assert "| 0.75 / 1.00 | +0.25 [" in table

@@ -7,6 +7,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from scipy import stats
+
 from loopsim import outcome_statistics, survival
 
 
@@ -203,3 +205,34 @@ def test_pooled_survival_draws_the_exponential_tail_from_the_horizon():
     assert t[0] == 10.0 and s[0] == pytest.approx(0.5)
     assert s[-1] == pytest.approx(0.5 * np.exp(-3 / 42 * (t[-1] - 10.0)))
     assert ax.get_yscale() == "log"
+
+
+def test_window_escape_rates_count_events_and_time_at_risk_per_window():
+    # runs at rest at 12, 14, 16 and 30; one censored at 40; one at rest before 10
+    times = [5.0, 12.0, 14.0, 16.0, 30.0, 40.0]
+    at_rest = [True, True, True, True, True, False]
+    table = survival.window_escape_rates(times, at_rest, [10.0, 15.0, 20.0, 40.0])
+    # exposure in (10, 15]: 2 + 4*5 (the runs ending at 14, 16, 30, 40 and 12)
+    assert list(table["events"]) == [2, 1, 1]
+    assert table["exposure"].tolist() == pytest.approx([2 + 4 + 5 + 5 + 5, 1 + 5 + 5,
+                                                        10 + 20])
+    # the windows' events and exposure add up to the tail after 10 (escape_rate)
+    rate, low, high, events, exposure = survival.escape_rate(times, at_rest, 10.0)
+    assert table["events"].sum() == events and table["exposure"].sum() == pytest.approx(exposure)
+    first = table.iloc[0]
+    assert first["low"] == pytest.approx(stats.chi2.ppf(0.025, 4) / (2 * 21.0))
+    assert first["high"] == pytest.approx(stats.chi2.ppf(0.975, 6) / (2 * 21.0))
+
+
+def test_one_rate_p_value_is_the_multinomial_g_test():
+    """Given the total, the events fall into the windows in proportion to their exposure
+    under one rate: the same statistic as scipy's G-test of those counts."""
+    events, exposures = np.array([30, 12, 3]), np.array([100.0, 60.0, 40.0])
+    expected = events.sum() * exposures / exposures.sum()
+    g, p = stats.power_divergence(events, expected, lambda_="log-likelihood")
+    assert survival.one_rate_p_value(events, exposures) == pytest.approx(p)
+    # the same rate in every window: nothing against it
+    assert survival.one_rate_p_value([10, 5], [20.0, 10.0]) == pytest.approx(1.0)
+    # a falling rate (a mixture of fast and slow cells) with enough events is found
+    assert survival.one_rate_p_value([60, 10], [100.0, 100.0]) < 1e-6
+    assert math.isnan(survival.one_rate_p_value([0, 0], [1.0, 1.0]))

@@ -79,8 +79,9 @@ def pooled_survival(frame, ax=None, horizon=survival.PAPER_HORIZON):
         ax.fill_between(t[shown], low[shown], high[shown], step="post", color="tab:blue",
                         alpha=0.15, linewidth=0)
         rate, rate_low, rate_high, events, _ = survival.escape_rate(times, at_rest, horizon)
-        before = np.searchsorted(t, horizon, side="right") - 1   # S is a step function
-        s_h = (float(sf[before]) if before >= 0 else 1.0) if horizon < t[-1] else np.nan
+        # S is a right-continuous step function from S(0) = 1: its value at the horizon
+        s_h = float(sf[np.searchsorted(t, horizon, side="right") - 1]) if horizon < t[-1] \
+            else np.nan
         if np.isfinite(rate) and s_h > 0:
             tail = np.linspace(horizon, t[-1], 50)
             for r, style, label in ((rate, "-", f"exp. tail, r = {rate:.2f} per t_u "
