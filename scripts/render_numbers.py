@@ -473,8 +473,8 @@ def _range_horizon_regimes():
     """The regime shares at t = 10 against those run to rest, at the cells in both
     ``data/paper_range_summary.parquet`` (t = 10, ``--seeds auto``, an earlier code) and
     ``data/paper_range_rest_summary.parquet`` (run to rest): per cell P(in-plane) and
-    P(3D) each way with the Newcombe interval of P(3D) run to rest minus at t = 10
-    (``range.t10-vs-rest-table``), and the differences pooled over the cells whose two
+    P(3D) each way with the Newcombe interval of P(3D) run to rest minus at t = 10, and
+    the median tilts (``range.t10-vs-rest-table``), and the differences pooled over the cells whose two
     samples have the same number of seeds (seeds 0 to K − 1 both), with the smallest
     difference they could detect.  Pooling can hide opposite changes in two cells; the
     table shows each.  Where the two samples' starts coincide they are positively
@@ -488,8 +488,9 @@ def _range_horizon_regimes():
     rest = keyed(pd.read_parquet(os.path.join(DATA, "paper_range_rest_summary.parquet")))
     both = ten.merge(rest, on=["g0", "theta0_deg"], suffixes=("_10", "_rest"))
     rows = ["| g0, θ0 | seeds: t = 10 / to rest | P(in-plane): t = 10 / to rest "
-            "| P(3D): t = 10 / to rest | P(3D) to rest − at t = 10 |",
-            "|---|--:|--:|--:|---|"]
+            "| P(3D): t = 10 / to rest | P(3D) to rest − at t = 10 "
+            "| median tilt (deg): t = 10 / to rest |",
+            "|---|--:|--:|--:|---|--:|"]
     pooled = {regime: [0, 0, 0] for regime in ("in_plane", "3d")}
     for _, r in both.iterrows():
         n10, nrest = int(r["seeds_10"]), int(r["seeds_rest"])
@@ -498,7 +499,8 @@ def _range_horizon_regimes():
         rows.append(f"| ({r['g0']:.1f}, {r['theta0_deg']:.0f}°) | {n10} / {nrest} | "
                     f"{r['p_in_plane_10']:.2f} / {r['p_in_plane_rest']:.2f} | "
                     f"{r['p_3d_10']:.2f} / {r['p_3d_rest']:.2f} | "
-                    f"{krest / nrest - k10 / n10:+.2f} [{low:+.2f}, {high:+.2f}] |")
+                    f"{krest / nrest - k10 / n10:+.2f} [{low:+.2f}, {high:+.2f}] | "
+                    f"{r['tilt_median_10']:.1f} / {r['tilt_median_rest']:.1f} |")
         if n10 == nrest:
             for regime, sums in pooled.items():
                 sums[0] += _counts(r[f"p_{regime}_10"], n10)

@@ -122,10 +122,12 @@ def test_the_horizon_comparison_pools_only_cells_with_equal_seeds(tmp_path, monk
 
     ten = pd.DataFrame({"g0": [300.0, 300.0, 350.0, 325.7142857142857],
                         "theta0_deg": [6.0, 12.0, 6.0, 12.0], "seeds": [4, 8, 8, 8],
-                        "p_in_plane": [1.0, 0.25, 0.5, 0.5], "p_3d": [0.0, 0.75, 0.5, 0.5]})
+                        "p_in_plane": [1.0, 0.25, 0.5, 0.5], "p_3d": [0.0, 0.75, 0.5, 0.5],
+                        "tilt_median": [30.0, 40.0, 50.0, 60.0]})
     rest = pd.DataFrame({"g0": [300.0, 300.0, 325.71428571428567],
                          "theta0_deg": [6.0, 12.0, 12.0], "seeds": [8, 8, 8],
-                         "p_in_plane": [0.5, 0.0, 0.375], "p_3d": [0.5, 1.0, 0.625]})
+                         "p_in_plane": [0.5, 0.0, 0.375], "p_3d": [0.5, 1.0, 0.625],
+                         "tilt_median": [10.0, 20.0, 30.0]})
     ten.to_parquet(tmp_path / "paper_range_summary.parquet")
     rest.to_parquet(tmp_path / "paper_range_rest_summary.parquet")
     monkeypatch.setattr(RENDER, "DATA", str(tmp_path))
@@ -138,4 +140,4 @@ def test_the_horizon_comparison_pools_only_cells_with_equal_seeds(tmp_path, monk
         f"{dd.detectable_probability_difference(10 / 16, 16, 16):.2f}")
     table = out["range.t10-vs-rest-table"]
     assert "| (300.0, 6°) | 4 / 8 |" in table and "(350.0, 6°)" not in table
-    assert "| 0.75 / 1.00 | +0.25 [" in table
+    assert "| 0.75 / 1.00 | +0.25 [" in table and "| 40.0 / 20.0 |" in table
