@@ -417,26 +417,25 @@ RANGE_THETA0 = tuple(range(6, 91, 6))
 
 
 def _range_sweeps():
-    """{theta0: rows} of the range sweeps under ``data/rest_runs`` (``range_rest_t<θ0>``,
-    one per tilt of :data:`RANGE_THETA0`, run to rest), those started so far."""
+    """{theta0: (rows, cases)} of the range sweeps under ``data/rest_runs``
+    (``range_rest_t<θ0>``, one per tilt of :data:`RANGE_THETA0`, run to rest), those
+    started so far: their finished rows and how many cases each holds in all."""
+    from loopsim import storage
+
     found = {}
     for theta0 in RANGE_THETA0:
         name = os.path.join("rest_runs", f"range_rest_t{theta0}")
         if os.path.isdir(os.path.join(DATA, name)):
-            found[theta0] = table(name)
+            cases = storage.read_sweep_file(os.path.join(DATA, name))["config"]["cases"]
+            found[theta0] = (table(name), len(cases))
     return found
-
-
-def _finished(rows):
-    """Whether every case of a sweep's rows (from ``read_results``) has finished."""
-    return len(rows) == len(rows.attrs["loopsim"]["sweep_config"]["cases"])
 
 
 def _range_rest_cost():
     """What a loop run to rest costs at the top of the range: ``wall_s`` of the finished
     range sweeps' rows (2 shared cores; a sweep still running has its slow cases still
     to come, so it is left out)."""
-    frames = {t: rows for t, rows in _range_sweeps().items() if _finished(rows)}
+    frames = {t: rows for t, (rows, cases) in _range_sweeps().items() if len(rows) == cases}
     if not frames:
         return {}
     walls = pd.concat(frames.values())["wall_s"].to_numpy(float)
@@ -453,10 +452,9 @@ def _range_rest_progress():
     and ``range.rest-rows-pending`` (each unfinished tilt with its runs committed so
     far, or "none")."""
     sweeps = _range_sweeps()
-    done = [t for t, rows in sweeps.items() if _finished(rows)]
+    done = [t for t, (rows, cases) in sweeps.items() if len(rows) == cases]
     pending = [f"{t}° (not started)" if t not in sweeps else
-               f"{t}° ({len(sweeps[t])} of "
-               f"{len(sweeps[t].attrs['loopsim']['sweep_config']['cases'])} runs)"
+               f"{t}° ({len(sweeps[t][0])} of {sweeps[t][1]} runs)"
                for t in RANGE_THETA0 if t not in done]
     return {"range.rest-rows-done": ", ".join(f"{t}°" for t in done) or "none",
             "range.rest-rows-pending": ", ".join(pending) or "none"}
