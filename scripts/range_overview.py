@@ -67,9 +67,11 @@ def cell_key(g0, theta0):
 
 def finished_cells(path):
     """{cell key: rows} of the cells of the sweep at ``path`` whose every case has finished
-    (``outcome_statistics.complete_cells``); none for a folder that is not (yet) a sweep."""
+    (``outcome_statistics.complete_cells``); none for a folder that is not (yet) a sweep
+    or a sweep with no finished case."""
     try:
-        return outcome_statistics.complete_cells(loopsim.read_results(path))
+        frame = loopsim.read_results(path)
+        return outcome_statistics.complete_cells(frame) if len(frame) else {}
     except (FileNotFoundError, ValueError) as exc:
         print(f"{path}: left out ({exc})", file=sys.stderr)
         return {}
