@@ -23,19 +23,38 @@ DATA = os.path.join(ROOT, "data")
 WINDOW_N = 8
 
 
-def run(out, figure):
-    return subprocess.run([sys.executable, SCRIPT, "--data", DATA, "--out", str(out),
+#: The committed sources as they stood before the range sweeps below 36° and above it
+#: ran (a data folder of links): the tests below then see every kind of cell (run to
+#: rest, at t = 10, from an unfinished part, never run) whatever the study has reached.
+FROZEN_REST_RUNS = ("rest_t18_326", "rest_t18_350", "rest_t24_350", "rest_t60_253",
+                    "range_rest_t36")
+
+
+@pytest.fixture(scope="module")
+def frozen(tmp_path_factory):
+    data = tmp_path_factory.mktemp("frozen") / "data"
+    (data / "rest_runs").mkdir(parents=True)
+    for name in ("paper_range_summary.parquet", "paper_range_top_summary.parquet",
+                 "paper_range_runs"):
+        (data / name).symlink_to(os.path.join(DATA, name))
+    for name in FROZEN_REST_RUNS:
+        (data / "rest_runs" / name).symlink_to(os.path.join(DATA, "rest_runs", name))
+    return str(data)
+
+
+def run(out, figure, data=DATA):
+    return subprocess.run([sys.executable, SCRIPT, "--data", data, "--out", str(out),
                            "--figure", str(figure), "--window-n", str(WINDOW_N)],
                           capture_output=True, text=True, cwd=ROOT)
 
 
 @pytest.fixture(scope="module")
-def overview(tmp_path_factory):
+def overview(tmp_path_factory, frozen):
     where = tmp_path_factory.mktemp("overview")
     out, figure = where / "overview.parquet", where / "overview.png"
-    done = run(out, figure)
+    done = run(out, figure, frozen)
     assert done.returncode == 0, done.stderr
-    return dict(table=pd.read_parquet(out), out=out, figure=figure)
+    return dict(table=pd.read_parquet(out), out=out, figure=figure, data=frozen)
 
 
 def cell(table, g0, theta0):
@@ -89,6 +108,7 @@ def test_a_cell_run_to_rest_is_its_largest_sample(overview):
 def test_a_cell_never_run_is_empty_not_zero(overview):
     table = overview["table"]
     empty = table[table["seeds"] == 0]
+    assert len(empty) == 44   # g0 = 252.9-350 at 42-90° but (252.9, 60°), before their sweeps
     assert (empty["source"] == "").all() and empty["p_3d"].isna().all()
     assert empty["p_not_rest_t10"].isna().all() and empty["at_rest"].isna().all()
 
@@ -100,7 +120,7 @@ def test_refuses_to_forget_a_known_cell(overview, tmp_path):
     out = tmp_path / "overview.parquet"
     pq.write_table(pa.Table.from_pandas(table, preserve_index=False).replace_schema_metadata(
         pq.read_schema(overview["out"]).metadata), out)   # an overview knowing one more cell
-    done = run(out, tmp_path / "figure.png")
+    done = run(out, tmp_path / "figure.png", overview["data"])
     assert done.returncode == 2 and "knows" in done.stderr and len(done.stderr.splitlines()) == 1
     assert pd.read_parquet(out)["seeds"].loc[gone] == 8 and not (tmp_path / "figure.png").exists()
     assert not (tmp_path / "range_survival.png").exists()
