@@ -30,7 +30,8 @@ Writes ``--out`` (columns: ``loopsim.columns.RANGE_OVERVIEW_COLUMNS``, each desc
 probabilities and P(not at rest by t = 10) per cell, the thresholds and the stable
 branch's upper edge) and ``--survival-figure`` (``loopsim.figures.pooled_survival``:
 every loop of the cells run to rest, the samples the table takes, pooled into one
-Kaplan–Meier survival with the exponential tail after t = 10).  It refuses (exit status 2, nothing written) where ``--out`` holds
+Kaplan–Meier survival for the 3D loops and one for the others, each with its exponential
+tail after t = 10).  It refuses (exit status 2, nothing written) where ``--out`` holds
 another kind of table, or an overview that knows a cell this run would not.
 """
 import argparse
@@ -245,7 +246,9 @@ def main(argv=None):
     from loopsim import figures
 
     figure = figures.range_overview(table, window)   # drawn before anything is written
-    survival = figures.pooled_survival(pooled) if pooled is not None else None
+    survival = None if pooled is None else figures.pooled_survival(pooled, groups={
+        "3D loops": pooled["regime"].eq("3d"),
+        "stable or in-plane": pooled["regime"].isin(("stable", "in-plane"))})
     arrow = pa.Table.from_pandas(table, preserve_index=False)
     arrow = arrow.replace_schema_metadata(storage.provenance(
         loopsim_range_overview=json.dumps(meta)))

@@ -543,10 +543,10 @@ TAIL_WINDOWS = (10.0, 15.0, 20.0, 40.0)
 def _range_rest_pooled():
     """Every loop of the cells run to rest pooled (``range.pooled-*``): how many came to
     rest by t_max (and those that did not, with their ``terminal_state``), P(at rest by
-    t = 10), the time by which 95 % rest, the latest settling time, the escape rate after
-    t = 10 and in each window of :data:`TAIL_WINDOWS` with the p-value of one rate across
-    them, and the most a tail at the rate's lower limit leaves moving at t_max of the
-    loops moving at t = 10."""
+    t = 10), the time by which 95 % rest, the latest settling time; and of the 3D loops'
+    tail, the escape rate after t = 10 and in each window of :data:`TAIL_WINDOWS` with the
+    p-value of one rate across them, and the most a tail at the rate's lower limit leaves
+    moving at t_max of the loops moving at t = 10 (the other loops' escape rate apart)."""
     from loopsim import survival
 
     rows = _rest_samples()
@@ -566,6 +566,15 @@ def _range_rest_pooled():
            "range.pooled-latest": (f"{times[at_rest].max():.1f}" if at_rest.any()
                                    else "none at rest"),
            "range.pooled-t-max": f"{t_max:g}"}
+    # the tail: the 3D loops tumble before they rest; a stable or in-plane loop not yet
+    # at rest approaches it slowly near the thresholds, at a rate of its own
+    tumbling = rows["regime"].eq("3d")
+    out["range.pooled-3d-loops"] = count(int(tumbling.sum()))
+    slow_times, slow_at_rest = survival.settling_times(rows[~tumbling])
+    rate, low, high, events, _ = survival.escape_rate(slow_times, slow_at_rest)
+    out["range.pooled-slow-escape"] = (f"{_interval(rate, low, high, 3)} ({events} events)"
+                                       if np.isfinite(rate) else f"{events} events: too few")
+    times, at_rest = survival.settling_times(rows[tumbling])
     rate, low, high, events, _ = survival.escape_rate(times, at_rest)
     out["range.pooled-escape"] = (f"{_interval(rate, low, high, 2)} ({events} events)"
                                   if np.isfinite(rate) else f"{events} events: too few")

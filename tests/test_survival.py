@@ -198,13 +198,17 @@ def test_pooled_survival_draws_the_exponential_tail_from_the_horizon():
                       ignore_index=True)
     ax = figures.pooled_survival(frame).axes[0]
     lines = {line.get_label(): line for line in ax.get_lines()}
-    steps = lines["Kaplan–Meier, 7 of 8 at rest"]
+    steps = lines["all loops: 7 of 8 at rest"]
     assert steps.get_ydata()[-1] == pytest.approx(1 / 8)
-    tail = lines["exp. tail, r = 0.07 per t_u (3 events)"]
+    tail = lines["all loops: exp. tail, r = 0.07 per t_u (3 events)"]
     t, s = tail.get_xdata(), tail.get_ydata()
     assert t[0] == 10.0 and s[0] == pytest.approx(0.5)
     assert s[-1] == pytest.approx(0.5 * np.exp(-3 / 42 * (t[-1] - 10.0)))
     assert ax.get_yscale() == "log"
+    # one curve per group: the cell at 350 alone (3 of 4 at rest, S ends at 1/4)
+    ax = figures.pooled_survival(frame, groups={"at 350": frame["g0"].eq(350.0)}).axes[0]
+    lines = {line.get_label(): line for line in ax.get_lines()}
+    assert lines["at 350: 3 of 4 at rest"].get_ydata()[-1] == pytest.approx(1 / 4)
 
 
 def test_window_escape_rates_count_events_and_time_at_risk_per_window():

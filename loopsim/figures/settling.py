@@ -60,42 +60,54 @@ def survival_curves(frame, ax=None, horizon=survival.PAPER_HORIZON):
     return fig
 
 
-def pooled_survival(frame, ax=None, horizon=survival.PAPER_HORIZON):
-    """Every loop of ``frame`` pooled into one Kaplan–Meier survival of "not yet at rest"
-    (95 % band), on a log axis, with the exponential tail S(t) = S(t_h) exp(−r (t − t_h))
-    from the paper's horizon t_h on, r the escape rate after t_h with its interval
-    (``survival.escape_rate``): a straight line where the tail is memoryless.  Returns the
-    figure."""
-    fig, ax = single_axes(ax, (6.0, 4.0))
-    times, at_rest = survival.settling_times(frame)
+def _pooled_curve(ax, times, at_rest, colour, name, horizon):
+    """One pooled Kaplan–Meier step curve with its band, and its exponential tail from
+    the horizon on with the rate's interval; the smallest S drawn (for the axis)."""
     curve = survival.survival_curve(times, at_rest)
-    if len(curve):
-        t = np.append(curve["t"].to_numpy(float), times.max())
-        sf, low, high = (np.append(curve[c].to_numpy(float), curve[c].iloc[-1])
-                         for c in ("sf", "sf_low", "sf_high"))
-        shown = sf > 0   # log axis: S = 0 (all at rest) ends the curve
-        ax.step(t[shown], sf[shown], where="post", color="tab:blue",
-                label=f"Kaplan–Meier, {int(at_rest.sum())} of {times.size} at rest")
-        ax.fill_between(t[shown], low[shown], high[shown], step="post", color="tab:blue",
-                        alpha=0.15, linewidth=0)
-        rate, rate_low, rate_high, events, _ = survival.escape_rate(times, at_rest, horizon)
-        # S is a right-continuous step function from S(0) = 1: its value at the horizon
-        s_h = float(sf[np.searchsorted(t, horizon, side="right") - 1]) if horizon < t[-1] \
-            else np.nan
-        if np.isfinite(rate) and s_h > 0:
-            tail = np.linspace(horizon, t[-1], 50)
-            for r, style, label in ((rate, "-", f"exp. tail, r = {rate:.2f} per t_u "
-                                     f"({events} events)"),
-                                    (rate_low, ":", "its 95 % interval"), (rate_high, ":", None)):
-                ax.plot(tail, s_h * np.exp(-r * (tail - horizon)), style, color="tab:red",
-                        linewidth=1, label=label)
-        ax.set_ylim(max(0.5 / max(times.size, 1), 1e-4), 1.3)
+    if not len(curve):
+        return 1.0
+    t = np.append(curve["t"].to_numpy(float), times.max())
+    sf, low, high = (np.append(curve[c].to_numpy(float), curve[c].iloc[-1])
+                     for c in ("sf", "sf_low", "sf_high"))
+    shown = sf > 0   # log axis: S = 0 (all at rest) ends the curve
+    ax.step(t[shown], sf[shown], where="post", color=colour,
+            label=f"{name}: {int(at_rest.sum())} of {times.size} at rest")
+    ax.fill_between(t[shown], low[shown], high[shown], step="post", color=colour,
+                    alpha=0.15, linewidth=0)
+    rate, rate_low, rate_high, events, _ = survival.escape_rate(times, at_rest, horizon)
+    # S is a right-continuous step function from S(0) = 1: its value at the horizon
+    s_h = float(sf[np.searchsorted(t, horizon, side="right") - 1]) if horizon < t[-1] \
+        else np.nan
+    if np.isfinite(rate) and s_h > 0:
+        tail = np.linspace(horizon, t[-1], 50)
+        for r, style, label in ((rate, "--", f"{name}: exp. tail, r = {rate:.2f} per t_u "
+                                 f"({events} events)"),
+                                (rate_low, ":", None), (rate_high, ":", None)):
+            ax.plot(tail, s_h * np.exp(-r * (tail - horizon)), style, color=colour,
+                    linewidth=1, label=label)
+    return float(sf[shown].min())
+
+
+def pooled_survival(frame, ax=None, horizon=survival.PAPER_HORIZON, groups=None):
+    """Loops of ``frame`` pooled into Kaplan–Meier survivals of "not yet at rest" (95 %
+    band), on a log axis, each with its exponential tail S(t) = S(t_h) exp(−r (t − t_h))
+    from the paper's horizon t_h on, r the escape rate after t_h (dashed; its 95 %
+    interval dotted; ``survival.escape_rate``): a straight line where the tail is
+    memoryless.  ``groups``: {name: boolean mask over the rows}, one curve each (default:
+    every loop, one curve).  Returns the figure."""
+    fig, ax = single_axes(ax, (6.0, 4.0))
+    groups = groups if groups is not None else {"all loops": np.ones(len(frame), bool)}
+    lowest = 1.0
+    for colour, (name, mask) in zip(CELL_COLOURS, groups.items()):
+        times, at_rest = survival.settling_times(frame[np.asarray(mask, bool)])
+        lowest = min(lowest, _pooled_curve(ax, times, at_rest, colour, name, horizon))
     ax.set_yscale("log")
+    ax.set_ylim(max(0.5 * lowest, 1e-4), 1.3)
     ax.axvline(horizon, color="0.4", linestyle="--", linewidth=1)
     ax.text(horizon, ax.get_ylim()[0] * 1.3, " the paper's horizon", color="0.4", fontsize=8)
     ax.set(xlabel="t (t_u)", ylabel="not yet at rest, S(t)")
     ax.legend(fontsize=7, loc="upper right", frameon=True, framealpha=0.9)
-    ax.set_title("all loops pooled: survival of “not yet at rest” (95 % band)", fontsize=9)
+    ax.set_title("loops pooled: survival of “not yet at rest” (95 % band)", fontsize=9)
     return fig
 
 
