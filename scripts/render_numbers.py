@@ -434,17 +434,21 @@ def _range_sweeps():
 def _range_rest_cost():
     """What a loop run to rest costs at the top of the range: ``wall_s`` of the finished
     range sweeps' rows (2 shared cores; a sweep still running has its slow cases still
-    to come, so it is left out)."""
+    to come, so it is left out), per loop and in all, and over the cells at θ0 >= 24°."""
     frames = {t: rows for t, (rows, cases) in _range_sweeps().items() if len(rows) == cases}
     if not frames:
         return {}
-    walls = pd.concat(frames.values())["wall_s"].to_numpy(float)
+    rows = pd.concat(frames.values())
+    walls = rows["wall_s"].to_numpy(float)
+    empty = rows[rows["theta0_deg"] >= 24]   # the cells no study had answered before
     return {"range.rest-runs": count(walls.size),
             "range.rest-tilts": f"{min(frames)}–{max(frames)}°",
             "range.rest-sample-median": f"{np.median(walls):.0f} s",
-            "range.rest-sample-span": f"{walls.min():.1f}–{walls.max():.0f} s",
+            "range.rest-sample-span": f"{walls.min():.2g}–{walls.max():.0f} s",
             "range.rest-cell-hours": f"{8 * walls.mean() / 3600:.2f} h",
-            "range.rest-cells60-hours": f"{60 * 8 * walls.mean() / 3600:.0f} h"}
+            "range.rest-total-hours": f"{walls.sum() / 3600:.1f} h",
+            "range.rest-empty-cells": count(empty.groupby(["g0", "theta0_deg"]).ngroups),
+            "range.rest-empty-hours": f"{empty['wall_s'].sum() / 3600:.1f} h"}
 
 
 def _range_rest_progress():

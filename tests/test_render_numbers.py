@@ -95,6 +95,16 @@ def test_no_loop_run_to_rest_tumbles_at_its_end():
     assert set(rows.loc[rows["stop_reason"].eq("t_end"), "terminal_state"]) <= {"quiet"}
 
 
+def test_the_regime_shares_the_study_page_says_stand_do():
+    """docs/studies/rest.md says the regime probabilities at t = 10 stand: the pooled
+    differences at rest minus at t = 10 have 0 inside their intervals."""
+    values = RENDER.numbers()
+    for regime in ("3d", "in-plane"):
+        shown = values[f"range.t10-vs-rest-{regime}"]
+        low, high = (float(v) for v in re.search(r"\[([-+\d.]+), ([-+\d.]+)\]", shown).groups())
+        assert low <= 0.0 <= high, shown
+
+
 def test_the_range_progress_is_the_range_summarys():
     import pandas as pd
 
