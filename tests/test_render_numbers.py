@@ -97,12 +97,16 @@ def test_no_loop_run_to_rest_tumbles_at_its_end():
 
 def test_the_regime_shares_the_study_page_says_stand_do():
     """docs/studies/rest.md says the regime probabilities at t = 10 stand: the pooled
-    differences at rest minus at t = 10 have 0 inside their intervals."""
+    differences at rest minus at t = 10, and each cell's, have 0 inside their intervals."""
     values = RENDER.numbers()
     for regime in ("3d", "in-plane"):
         shown = values[f"range.t10-vs-rest-{regime}"]
         low, high = (float(v) for v in re.search(r"\[([-+\d.]+), ([-+\d.]+)\]", shown).groups())
         assert low <= 0.0 <= high, shown
+    for row in values["range.t10-vs-rest-table"].strip().splitlines()[2:]:
+        low, high = (float(v) for v in re.search(r"\| [-+\d.]+ \[([-+\d.]+), ([-+\d.]+)\] \|",
+                                                 row).groups())
+        assert low <= 0.0 <= high, row
 
 
 def test_the_range_progress_is_the_range_summarys():
