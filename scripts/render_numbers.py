@@ -416,6 +416,7 @@ def _range_overview():
 RANGE_THETA0 = tuple(range(6, 91, 6))
 
 
+@functools.lru_cache(maxsize=None)   # two groups read them: once
 def _range_sweeps():
     """{theta0: (rows, cases)} of the range sweeps under ``data/rest_runs``
     (``range_rest_t<θ0>``, one per tilt of :data:`RANGE_THETA0`, run to rest), those
